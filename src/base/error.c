@@ -1,0 +1,40 @@
+/* Error reporting and checked allocation. */
+#include "base/error.h"
+
+#include <stdarg.h>
+#include <string.h>
+
+static _Thread_local char error_message[1024];
+static _Thread_local fs_errdomain error_domain = FS_OK;
+
+void fs_error(fs_errdomain domain, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(error_message, sizeof error_message, fmt, ap);
+    va_end(ap);
+    error_domain = domain;
+}
+
+const char *fs_error_message(void) { return error_message; }
+fs_errdomain fs_error_domain(void) { return error_domain; }
+
+void fs_error_clear(void)
+{
+    error_message[0] = '\0';
+    error_domain = FS_OK;
+}
+
+static void *check_alloc(void *p, size_t size)
+{
+    if (!p && size) {
+        fprintf(stderr, "fissure: out of memory (%zu bytes)\n", size);
+        abort();
+    }
+    return p;
+}
+
+void *fs_malloc(size_t size) { return check_alloc(malloc(size ? size : 1), size); }
+void *fs_calloc(size_t count, size_t size) { return check_alloc(calloc(count ? count : 1, size ? size : 1), count * size); }
+void *fs_realloc(void *ptr, size_t size) { return check_alloc(realloc(ptr, size ? size : 1), size); }
+char *fs_strdup(const char *s) { return s ? check_alloc(strdup(s), strlen(s) + 1) : NULL; }

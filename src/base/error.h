@@ -1,0 +1,44 @@
+/* Error reporting: one pending message per thread and an error domain that is the CLI's exit status. */
+#ifndef FS_BASE_ERROR_H
+#define FS_BASE_ERROR_H
+
+#include <stdio.h>
+#include <stdlib.h>
+
+/* The domain of an error doubles as the process exit status (sysexits.h values). */
+typedef enum {
+    FS_OK = 0,
+    FS_ERR_USAGE = 64,    /* bad command line */
+    FS_ERR_DATA = 65,     /* bad preset or input data */
+    FS_ERR_NOINPUT = 66,  /* missing input file */
+    FS_ERR_INTERNAL = 70, /* internal error: a library failed, a solver did not converge */
+    FS_ERR_CANTCREAT = 73,/* cannot create output */
+    FS_ERR_IO = 74        /* read or write failed */
+} fs_errdomain;
+
+/* Records an error (printf-style). A later call replaces an earlier message. Functions that fail
+ * call this and return -1 (or NULL); the caller either handles it or passes the failure up. */
+void fs_error(fs_errdomain domain, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* The pending message ("" if none) and its domain (FS_OK if none). */
+const char *fs_error_message(void);
+fs_errdomain fs_error_domain(void);
+void fs_error_clear(void);
+
+/* Programming errors: abort with file and line. Always on (cheap checks only). */
+#define FS_ASSERT(cond)                                                                    \
+    do {                                                                                   \
+        if (!(cond)) {                                                                     \
+            fprintf(stderr, "fissure: internal error: %s:%d: assertion '%s' failed\n",   \
+                    __FILE__, __LINE__, #cond);                                            \
+            abort();                                                                       \
+        }                                                                                  \
+    } while (0)
+
+/* Allocation that aborts on exhaustion: out-of-memory is not a recoverable input error here. */
+void *fs_malloc(size_t size);
+void *fs_calloc(size_t count, size_t size);
+void *fs_realloc(void *ptr, size_t size);
+char *fs_strdup(const char *s);
+
+#endif

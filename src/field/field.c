@@ -1,0 +1,1 @@
+#include "field/field.h"

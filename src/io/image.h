@@ -1,0 +1,60 @@
+/* Images: reading, atomic writing, comparison and distance transforms (C interface to OpenCV,
+ * implemented in image.cpp, the only file that includes OpenCV). */
+#ifndef FS_IO_IMAGE_H
+#define FS_IO_IMAGE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum { FS_PIX_U8 = 0, FS_PIX_U16 = 1, FS_PIX_F32 = 2 } fs_pixel_type;
+
+/* Interleaved pixels, rows top to bottom; RGB order for three channels. */
+typedef struct {
+    int width, height, channels;
+    fs_pixel_type type;
+    void *data;   /* width * height * channels elements, owned */
+} fs_image;
+
+/* Allocates a zeroed image. */
+void fs_image_alloc(fs_image *img, int width, int height, int channels, fs_pixel_type type);
+void fs_image_free(fs_image *img);
+size_t fs_image_bytes(const fs_image *img);
+
+/* Reads PNG/EXR/any format OpenCV reads, keeping bit depth and channels (BGR converted to RGB).
+ * Returns 0, or -1 with fs_error(FS_ERR_NOINPUT) for a missing file, FS_ERR_DATA for an unreadable one. */
+int fs_image_read(const char *path, fs_image *out);
+
+/* Reads an image as grey levels in [0, 1] (any depth, colour averaged). */
+int fs_image_read_grey(const char *path, int *width, int *height, float **grey);
+
+/* Writes the image to exactly `path` (format from its extension: .png, .exr). Not atomic by itself:
+ * io/output.h stages files under temporary names. Returns 0 or -1 with fs_error(FS_ERR_IO). */
+int fs_image_write(const char *path, const fs_image *img);
+
+typedef struct {
+    double psnr;      /* dB over all channels, +inf when identical */
+    double ssim;      /* mean SSIM over channels (Gaussian 11x11, sigma 1.5) */
+    double max_diff;  /* largest absolute difference, as a fraction of the full range */
+} fs_image_diff;
+
+/* Compares two images of the same size and channel count (depths may differ: both are scaled to
+ * [0,1]). Returns 0, or -1 with fs_error(FS_ERR_DATA) when sizes or channels differ. */
+int fs_image_compare(const fs_image *a, const fs_image *b, fs_image_diff *out);
+
+/* Euclidean distance (pixels) from each pixel to the nearest pixel with mask != 0; wraps on the
+ * given axes so that distances continue across the seam. dist has width * height floats. */
+int fs_image_distance(const uint8_t *mask, int width, int height, bool wrap_u, bool wrap_v, float *dist);
+
+/* Area-averaging resize of a float single-channel buffer (used for supersampling). */
+void fs_image_downsample(const float *src, int src_w, int src_h, float *dst, int dst_w, int dst_h);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

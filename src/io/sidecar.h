@@ -1,0 +1,25 @@
+/* The JSON sidecar written beside the maps (jansson). */
+#ifndef FS_IO_SIDECAR_H
+#define FS_IO_SIDECAR_H
+
+#include <stdint.h>
+
+#include "render/render.h"
+#include "sim/config.h"
+#include "sim/sim.h"
+
+/* One written map, as the sidecar describes it. */
+typedef struct {
+    const char *kind;        /* "height", "normal", ... */
+    const char *file;        /* file name (no directory) */
+    const fs_image *image;
+    const char *color_space; /* "linear", "srgb", "data" */
+} fs_sidecar_map;
+
+/* Writes the sidecar to path: version, preset name and hash, seed, every resolved parameter,
+ * statistics, and per map its colour space, bit depth, channels, normal convention, height scale
+ * and tileability. preset_text is the preset file's content (hashed), or NULL. Returns 0 or -1. */
+int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_text, const fs_stats *stats,
+                     const fs_maps *maps, const fs_sidecar_map *list, int n_maps, double wall_seconds);
+
+#endif

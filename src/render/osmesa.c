@@ -1,0 +1,1 @@
+/* placeholder */ typedef int fs_placeholder_15351;
