@@ -1,0 +1,36 @@
+# Shared helpers of the shell tests: a scratch directory, outcome counting, PNG header checks.
+# The harness exports FISSURE (the binary) and top_srcdir (the source tree).
+set -u
+: "${FISSURE:?FISSURE must name the fissure binary}"
+: "${top_srcdir:?top_srcdir must name the source tree}"
+PRESETS="$top_srcdir/presets"
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/fissure-test.XXXXXX")
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+
+ok() { printf 'ok %s\n' "$*"; }
+not_ok() { printf 'FAIL %s\n' "$*"; failures=$((failures + 1)); }
+# expect_status WANT DESCRIPTION CMD...: runs CMD, checks its exit status, keeps stdout/stderr in $tmp.
+expect_status() {
+    want=$1; what=$2; shift 2
+    "$@" >"$tmp/stdout" 2>"$tmp/stderr"; got=$?
+    if [ "$got" -eq "$want" ]; then ok "$what"; else
+        not_ok "$what: exit status $got, expected $want"; sed 's/^/    stderr: /' "$tmp/stderr" | head -5
+    fi
+}
+# png_header FILE: prints "WIDTH HEIGHT BITDEPTH COLORTYPE" from the IHDR chunk.
+png_header() {
+    od -An -tu1 -j16 -N10 "$1" | awk '{ printf "%d %d %d %d\n", \
+        (($1*256+$2)*256+$3)*256+$4, (($5*256+$6)*256+$7)*256+$8, $9, $10 }'
+}
+# expect_png FILE W H DEPTH COLORTYPE (0 grey, 2 RGB)
+expect_png() {
+    if [ ! -f "$1" ]; then not_ok "$1 exists"; return; fi
+    got=$(png_header "$1")
+    if [ "$got" = "$2 $3 $4 $5" ]; then ok "$(basename "$1") is ${2}x$3, $4-bit, colour type $5"
+    else not_ok "$(basename "$1"): header '$got', expected '$2 $3 $4 $5'"; fi
+}
+finish() {
+    if [ "$failures" -eq 0 ]; then exit 0; fi
+    printf '%d failure(s)\n' "$failures"; exit 1
+}

@@ -1,1 +1,297 @@
-int main(void) { return 77; }
+/* Tests of image I/O, comparison, distance transform and downsampling (io/image.h). */
+#include "io/image.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "base/error.h"
+#include "check.h"
+
+static char tmpdir[] = "/tmp/fissure-test-image-XXXXXX";
+
+static const char *tmp_path(const char *name)
+{
+    static char path[256];
+    snprintf(path, sizeof path, "%s/%s", tmpdir, name);
+    return path;
+}
+
+/* A deterministic pattern that exercises every bit of each sample. */
+static uint32_t pattern(size_t k)
+{
+    uint32_t x = (uint32_t)k * 2654435761u + 12345u;
+    x ^= x >> 15;
+    x *= 2246822519u;
+    return x ^ (x >> 13);
+}
+
+static void roundtrip(int channels, fs_pixel_type type, const char *name)
+{
+    fs_image a, b = {0};
+    fs_image_alloc(&a, 37, 23, channels, type);
+    size_t n = (size_t)a.width * a.height * channels;
+    for (size_t k = 0; k < n; k++) {
+        if (type == FS_PIX_U8)
+            ((uint8_t *)a.data)[k] = (uint8_t)pattern(k);
+        else if (type == FS_PIX_U16)
+            ((uint16_t *)a.data)[k] = (uint16_t)pattern(k);
+        else
+            ((float *)a.data)[k] = (float)((double)pattern(k) / 4294967296.0 * 200.0 - 50.0);
+    }
+    CHECK_MSG(fs_image_write(tmp_path(name), &a) == 0, "%s", fs_error_message());
+    CHECK_MSG(fs_image_read(tmp_path(name), &b) == 0, "%s", fs_error_message());
+    CHECK(b.width == a.width && b.height == a.height && b.channels == channels && b.type == type);
+    if (b.data && b.width == a.width && b.height == a.height && b.channels == channels && b.type == type) {
+        if (type == FS_PIX_F32) {
+            double worst = 0.0;
+            for (size_t k = 0; k < n; k++)
+                worst = fmax(worst, fabs((double)((float *)a.data)[k] - ((float *)b.data)[k]));
+            CHECK_NEAR(worst, 0.0, 1e-6);
+        } else {
+            CHECK(memcmp(a.data, b.data, fs_image_bytes(&a)) == 0);
+        }
+    }
+    fs_image_free(&a);
+    fs_image_free(&b);
+}
+
+/* 8- and 16-bit PNG, grey and RGB, are lossless; EXR keeps 32-bit floats. */
+static void test_roundtrip(void)
+{
+    roundtrip(1, FS_PIX_U8, "g8.png");
+    roundtrip(3, FS_PIX_U8, "rgb8.png");
+    roundtrip(1, FS_PIX_U16, "g16.png");
+    roundtrip(3, FS_PIX_U16, "rgb16.png");
+    roundtrip(1, FS_PIX_F32, "g.exr");
+    roundtrip(3, FS_PIX_F32, "rgb.exr");
+}
+
+/* Channel order on disk is BGR (what every other reader expects): a pure red image read back as
+ * grey averages to 1/3, and its first channel is red after reading. */
+static void test_channel_order(void)
+{
+    fs_image a, b = {0};
+    fs_image_alloc(&a, 4, 4, 3, FS_PIX_U8);
+    for (int k = 0; k < 16; k++)
+        ((uint8_t *)a.data)[3 * k] = 255;
+    CHECK(fs_image_write(tmp_path("red.png"), &a) == 0);
+    CHECK(fs_image_read(tmp_path("red.png"), &b) == 0);
+    CHECK(b.data && ((uint8_t *)b.data)[0] == 255 && ((uint8_t *)b.data)[1] == 0 && ((uint8_t *)b.data)[2] == 0);
+    int w = 0, h = 0;
+    float *g = NULL;
+    CHECK(fs_image_read_grey(tmp_path("red.png"), &w, &h, &g) == 0);
+    CHECK(w == 4 && h == 4);
+    if (g)
+        CHECK_NEAR(g[5], 1.0 / 3.0, 1e-6);
+    free(g);
+    fs_image_free(&a);
+    fs_image_free(&b);
+}
+
+/* Identical images: PSNR +inf, SSIM 1, max difference 0. */
+static void test_compare_identical(void)
+{
+    fs_image a;
+    fs_image_alloc(&a, 32, 24, 3, FS_PIX_U16);
+    for (size_t k = 0; k < 32 * 24 * 3; k++)
+        ((uint16_t *)a.data)[k] = (uint16_t)pattern(k);
+    fs_image_diff d;
+    CHECK(fs_image_compare(&a, &a, &d) == 0);
+    CHECK(isinf(d.psnr) && d.psnr > 0);
+    CHECK(d.ssim == 1.0);
+    CHECK(d.max_diff == 0.0);
+    fs_image_free(&a);
+}
+
+/* One pixel of a 64 x 48 grey image off by 51/255 = 0.2: MSE = 0.04 / 3072, so
+ * PSNR = 10 log10(3072 / 0.04) dB, and the max difference is 0.2. Depths may differ: the same
+ * image at 16 bits compares as identical. */
+static void test_compare_known(void)
+{
+    fs_image a, b, c;
+    fs_image_alloc(&a, 64, 48, 1, FS_PIX_U8);
+    fs_image_alloc(&b, 64, 48, 1, FS_PIX_U8);
+    fs_image_alloc(&c, 64, 48, 1, FS_PIX_U16);
+    for (size_t k = 0; k < 64 * 48; k++) {
+        uint8_t v = (uint8_t)(100 + (k % 7) * 10);
+        ((uint8_t *)a.data)[k] = ((uint8_t *)b.data)[k] = v;
+        ((uint16_t *)c.data)[k] = (uint16_t)(v * 257);
+    }
+    ((uint8_t *)b.data)[64 * 20 + 30] += 51;
+    fs_image_diff d;
+    CHECK(fs_image_compare(&a, &b, &d) == 0);
+    CHECK_NEAR(d.psnr, 10.0 * log10(3072.0 / 0.04), 1e-9);
+    CHECK_NEAR(d.max_diff, 0.2, 1e-12);
+    CHECK(d.ssim < 1.0 && d.ssim > 0.9);
+    CHECK(fs_image_compare(&a, &c, &d) == 0);
+    CHECK(isinf(d.psnr));
+    CHECK_NEAR(d.max_diff, 0.0, 1e-12);
+    fs_image_free(&a);
+    fs_image_free(&b);
+    fs_image_free(&c);
+}
+
+/* Images of different sizes cannot be compared: -1 with FS_ERR_DATA. */
+static void test_compare_mismatch(void)
+{
+    fs_image a, b;
+    fs_image_alloc(&a, 8, 8, 1, FS_PIX_U8);
+    fs_image_alloc(&b, 8, 9, 1, FS_PIX_U8);
+    fs_image_diff d;
+    fs_error_clear();
+    CHECK(fs_image_compare(&a, &b, &d) == -1);
+    CHECK(fs_error_domain() == FS_ERR_DATA);
+    fs_image_free(&a);
+    fs_image_free(&b);
+}
+
+/* The distance from a single marked pixel is the Euclidean distance, in pixels. */
+static void test_distance_single(void)
+{
+    enum { W = 40, H = 30, X0 = 12, Y0 = 9 };
+    uint8_t mask[W * H] = {0};
+    float dist[W * H];
+    mask[Y0 * W + X0] = 1;
+    CHECK(fs_image_distance(mask, W, H, false, false, dist) == 0);
+    double worst = 0.0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            worst = fmax(worst, fabs(dist[y * W + x] - hypot(x - X0, y - Y0)));
+    CHECK_NEAR(worst, 0.0, 1e-4);
+    CHECK(dist[Y0 * W + X0] == 0.0f);
+}
+
+/* With wrapping, the distance across the seam is the short way round: a pixel at x = 1 seen from
+ * x = W - 2 is 3 pixels away, not W - 3; on a non-wrapping axis it stays the long way. */
+static void test_distance_wrap(void)
+{
+    enum { W = 50, H = 20 };
+    uint8_t mask[W * H] = {0};
+    float dist[W * H];
+    mask[5 * W + 1] = 1;
+    CHECK(fs_image_distance(mask, W, H, true, false, dist) == 0);
+    CHECK_NEAR(dist[5 * W + (W - 2)], 3.0, 1e-4);
+    CHECK_NEAR(dist[19 * W + 1], 14.0, 1e-4);
+    CHECK(fs_image_distance(mask, W, H, true, true, dist) == 0);
+    CHECK_NEAR(dist[19 * W + 1], 6.0, 1e-4);
+    CHECK_NEAR(dist[18 * W + (W - 1)], hypot(2.0, 7.0), 1e-4);
+    CHECK(fs_image_distance(mask, W, H, false, false, dist) == 0);
+    CHECK_NEAR(dist[5 * W + (W - 2)], W - 3.0, 1e-4);
+}
+
+/* Wrapped distances agree with a brute-force periodic minimum on a map whose distances exceed the
+ * first padding tried (large empty regions). */
+static void test_distance_wrap_far(void)
+{
+    enum { W = 600, H = 300 };
+    uint8_t *mask = calloc(W * H, 1);
+    float *dist = malloc(W * H * sizeof *dist);
+    const int px[3] = {3, 590, 300}, py[3] = {2, 150, 297};
+    for (int k = 0; k < 3; k++)
+        mask[py[k] * W + px[k]] = 1;
+    CHECK(fs_image_distance(mask, W, H, true, true, dist) == 0);
+    double worst = 0.0;
+    for (int y = 0; y < H; y += 7) {
+        for (int x = 0; x < W; x += 5) {
+            double best = INFINITY;
+            for (int k = 0; k < 3; k++) {
+                double dx = fabs((double)(x - px[k])), dy = fabs((double)(y - py[k]));
+                dx = fmin(dx, W - dx);
+                dy = fmin(dy, H - dy);
+                best = fmin(best, hypot(dx, dy));
+            }
+            worst = fmax(worst, fabs(dist[y * W + x] - best));
+        }
+    }
+    CHECK_NEAR(worst, 0.0, 1e-3);
+    free(mask);
+    free(dist);
+}
+
+/* An empty mask has no crack to be near: every distance is +inf. */
+static void test_distance_empty(void)
+{
+    uint8_t mask[16] = {0};
+    float dist[16];
+    CHECK(fs_image_distance(mask, 4, 4, true, true, dist) == 0);
+    CHECK(isinf(dist[0]) && isinf(dist[15]));
+}
+
+/* Area downsampling by an integer factor is the mean of each block. */
+static void test_downsample(void)
+{
+    float src[8 * 4], dst[2 * 1];
+    for (int k = 0; k < 32; k++)
+        src[k] = (float)k;
+    CHECK(fs_image_downsample(src, 8, 4, dst, 2, 1) == 0);
+    /* Left block: columns 0..3 of rows 0..3: mean of (x + 8y) = 1.5 + 12. */
+    CHECK_NEAR(dst[0], 13.5, 1e-5);
+    CHECK_NEAR(dst[1], 17.5, 1e-5);
+}
+
+/* A missing file is FS_ERR_NOINPUT; a file that is not an image is FS_ERR_DATA. */
+static void test_read_errors(void)
+{
+    fs_image img = {0};
+    fs_error_clear();
+    CHECK(fs_image_read(tmp_path("does-not-exist.png"), &img) == -1);
+    CHECK(fs_error_domain() == FS_ERR_NOINPUT);
+    CHECK(strstr(fs_error_message(), "does-not-exist.png") != NULL);
+    FILE *f = fopen(tmp_path("junk.png"), "wb");
+    CHECK(f != NULL);
+    if (f) {
+        fputs("this is not a PNG file\n", f);
+        fclose(f);
+    }
+    fs_error_clear();
+    CHECK(fs_image_read(tmp_path("junk.png"), &img) == -1);
+    CHECK(fs_error_domain() == FS_ERR_DATA);
+    int w, h;
+    float *g = NULL;
+    fs_error_clear();
+    CHECK(fs_image_read_grey(tmp_path("nothing.png"), &w, &h, &g) == -1);
+    CHECK(fs_error_domain() == FS_ERR_NOINPUT);
+}
+
+/* Writing into a directory that does not exist fails with FS_ERR_IO. */
+static void test_write_error(void)
+{
+    fs_image a;
+    fs_image_alloc(&a, 4, 4, 1, FS_PIX_U8);
+    fs_error_clear();
+    CHECK(fs_image_write(tmp_path("no/such/dir/x.png"), &a) == -1);
+    CHECK(fs_error_domain() == FS_ERR_IO);
+    fs_image_free(&a);
+}
+
+static void remove_tmpdir(void)
+{
+    const char *names[] = {"g8.png", "rgb8.png", "g16.png", "rgb16.png", "g.exr", "rgb.exr", "red.png", "junk.png"};
+    for (size_t k = 0; k < sizeof names / sizeof *names; k++)
+        unlink(tmp_path(names[k]));
+    rmdir(tmpdir);
+}
+
+int main(void)
+{
+    if (!mkdtemp(tmpdir)) {
+        perror("mkdtemp");
+        return 99;
+    }
+    RUN(test_roundtrip);
+    RUN(test_channel_order);
+    RUN(test_compare_identical);
+    RUN(test_compare_known);
+    RUN(test_compare_mismatch);
+    RUN(test_distance_single);
+    RUN(test_distance_wrap);
+    RUN(test_distance_wrap_far);
+    RUN(test_distance_empty);
+    RUN(test_downsample);
+    RUN(test_read_errors);
+    RUN(test_write_error);
+    remove_tmpdir();
+    return check_finish();
+}

@@ -1,1 +1,373 @@
-int main(void) { return 0; }
+/* fissure: command-line entry point — options, preset loading, the run, and writing the maps. */
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "base/log.h"
+#include "cli/cli.h"
+#include "config.h"
+#include "io/output.h"
+#include "io/preset.h"
+#include "io/sidecar.h"
+#include "render/render.h"
+#include "sim/sim.h"
+
+enum { MAP_HEIGHT, MAP_NORMAL, MAP_BASECOLOR, MAP_CRACKMASK, MAP_CRACKDIST, MAP_CELLID, MAP_COUNT };
+static const char *const map_names[MAP_COUNT] = {"height", "normal", "basecolor", "crackmask", "crackdist", "cellid"};
+static const char *const map_color_spaces[MAP_COUNT] = {"linear", "data", "srgb", "linear", "linear", "data"};
+
+typedef struct {
+    const char *output_dir;
+    const char *name;
+    bool have_seed;
+    uint64_t seed;
+    bool have_size;
+    int width, height;
+    char **sets;
+    int n_sets;
+    bool maps[MAP_COUNT];
+    bool exr;
+    bool have_normal;
+    fs_normal_convention normal;
+    bool list_presets, dump_preset;
+} options;
+
+enum {
+    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP
+};
+
+static const struct option long_options[] = {
+    {"output", required_argument, NULL, 'o'},
+    {"name", required_argument, NULL, 'n'},
+    {"seed", required_argument, NULL, 's'},
+    {"size", required_argument, NULL, OPT_SIZE},
+    {"set", required_argument, NULL, OPT_SET},
+    {"maps", required_argument, NULL, OPT_MAPS},
+    {"format", required_argument, NULL, OPT_FORMAT},
+    {"normal", required_argument, NULL, OPT_NORMAL},
+    {"quiet", no_argument, NULL, 'q'},
+    {"verbose", no_argument, NULL, 'v'},
+    {"list-presets", no_argument, NULL, OPT_LIST},
+    {"dump-preset", no_argument, NULL, OPT_DUMP},
+    {"help", no_argument, NULL, 'h'},
+    {"version", no_argument, NULL, 'V'},
+    {NULL, 0, NULL, 0},
+};
+
+static void print_help(FILE *out)
+{
+    fputs("Usage: fissure [OPTION]... PRESET\n"
+          "       fissure diff [OPTION]... A B\n"
+          "Grow a crack pattern by simulation and render it into texture maps.\n"
+          "PRESET is a preset file, or the name of one found on the preset path.\n"
+          "\n"
+          "  -o, --output DIR        write the maps into DIR (default: the current directory)\n"
+          "  -n, --name NAME         file name prefix of the maps (default: the preset's name)\n"
+          "  -s, --seed N            random seed (overrides [preset] seed)\n"
+          "      --size WxH          map size in pixels (overrides [render] size)\n"
+          "      --set SECTION.KEY=VALUE\n"
+          "                          override one preset key (repeatable)\n"
+          "      --maps LIST         comma-separated maps to write: height, normal, basecolor,\n"
+          "                          crackmask, crackdist, cellid, or all (default: all)\n"
+          "      --format png|exr    height map as 16-bit PNG (default) or float EXR in cm\n"
+          "      --normal opengl|directx\n"
+          "                          normal map convention (default: opengl, +Y up)\n"
+          "  -q, --quiet             print nothing on stderr but errors\n"
+          "  -v, --verbose           print details of each phase on stderr\n"
+          "      --list-presets      list the presets on the preset path, one a line, and exit\n"
+          "      --dump-preset       print the fully resolved preset as INI and exit\n"
+          "  -h, --help              print this help and exit\n"
+          "  -V, --version           print the version and exit\n"
+          "\n"
+          "The paths of the written files go to stdout, one a line; progress goes to stderr.\n"
+          "Exit status: 0 success, 64 usage error, 65 bad preset or input data, 66 missing input,\n"
+          "70 internal error, 73 cannot create output, 74 I/O error.\n"
+          "See fissure(1) and fissure-preset(5).\n",
+          out);
+}
+
+static int usage_error(const char *fmt, const char *arg)
+{
+    fputs("fissure: ", stderr);
+    fprintf(stderr, fmt, arg);
+    fputs("\nTry 'fissure --help' for more information.\n", stderr);
+    return FS_ERR_USAGE;
+}
+
+/* Parses "WxH" with both sides in [16, 16384]. */
+static bool parse_size(const char *s, int *w, int *h)
+{
+    char *end;
+    errno = 0;
+    long a = strtol(s, &end, 10);
+    if (end == s || (*end != 'x' && *end != 'X'))
+        return false;
+    const char *rest = end + 1;
+    long b = strtol(rest, &end, 10);
+    if (end == rest || *end || errno || a < 16 || b < 16 || a > 16384 || b > 16384)
+        return false;
+    *w = (int)a;
+    *h = (int)b;
+    return true;
+}
+
+static bool parse_maps(const char *list, bool *maps)
+{
+    memset(maps, 0, MAP_COUNT * sizeof *maps);
+    char *copy = fs_strdup(list), *save = NULL;
+    bool ok = true, any = false;
+    for (char *tok = strtok_r(copy, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        bool found = false;
+        if (!strcmp(tok, "all")) {
+            for (int i = 0; i < MAP_COUNT; i++)
+                maps[i] = true;
+            found = true;
+        }
+        for (int i = 0; i < MAP_COUNT && !found; i++)
+            if (!strcmp(tok, map_names[i]))
+                maps[i] = found = true;
+        ok = ok && found;
+        any = any || found;
+    }
+    free(copy);
+    return ok && any;
+}
+
+static int parse_options(int argc, char **argv, options *o)
+{
+    int c;
+    while ((c = getopt_long(argc, argv, "o:n:s:qvhV", long_options, NULL)) != -1) {
+        switch (c) {
+        case 'o': o->output_dir = optarg; break;
+        case 'n':
+            if (!*optarg || strchr(optarg, '/'))
+                return usage_error("--name: expected a file name prefix without '/', got '%s'", optarg);
+            o->name = optarg;
+            break;
+        case 's': {
+            char *end;
+            errno = 0;
+            unsigned long long v = strtoull(optarg, &end, 10);
+            if (end == optarg || *end || errno || optarg[0] == '-')
+                return usage_error("--seed: expected a non-negative integer, got '%s'", optarg);
+            o->have_seed = true;
+            o->seed = v;
+            break;
+        }
+        case OPT_SIZE:
+            if (!parse_size(optarg, &o->width, &o->height))
+                return usage_error("--size: expected WxH with each side from 16 to 16384, got '%s'", optarg);
+            o->have_size = true;
+            break;
+        case OPT_SET:
+            o->sets = fs_realloc(o->sets, (size_t)(o->n_sets + 1) * sizeof *o->sets);
+            o->sets[o->n_sets++] = optarg;
+            break;
+        case OPT_MAPS:
+            if (!parse_maps(optarg, o->maps))
+                return usage_error("--maps: expected a comma-separated list of height, normal, basecolor, "
+                                   "crackmask, crackdist, cellid or all, got '%s'", optarg);
+            break;
+        case OPT_FORMAT:
+            if (strcmp(optarg, "png") && strcmp(optarg, "exr"))
+                return usage_error("--format: expected png or exr, got '%s'", optarg);
+            o->exr = !strcmp(optarg, "exr");
+            break;
+        case OPT_NORMAL:
+            if (strcmp(optarg, "opengl") && strcmp(optarg, "directx"))
+                return usage_error("--normal: expected opengl or directx, got '%s'", optarg);
+            o->have_normal = true;
+            o->normal = strcmp(optarg, "directx") ? FS_NORMAL_OPENGL : FS_NORMAL_DIRECTX;
+            break;
+        case 'q': fs_log_set_level(FS_LOG_QUIET); break;
+        case 'v': fs_log_set_level(FS_LOG_VERBOSE); break;
+        case OPT_LIST: o->list_presets = true; break;
+        case OPT_DUMP: o->dump_preset = true; break;
+        case 'h': print_help(stdout); return -1;
+        case 'V': printf("fissure %s\n", PACKAGE_VERSION); return -1;
+        default: fputs("Try 'fissure --help' for more information.\n", stderr); return FS_ERR_USAGE;
+        }
+    }
+    return 0;
+}
+
+static int fail(void)
+{
+    fs_progress_done();
+    fprintf(stderr, "fissure: %s\n", fs_error_message());
+    int status = fs_error_domain();
+    return status == FS_OK ? FS_ERR_INTERNAL : status;
+}
+
+/* Reads a whole (small) text file for hashing; NULL if unreadable. */
+static char *read_text(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    size_t cap = 4096, n = 0;
+    char *buf = fs_malloc(cap);
+    size_t got;
+    while ((got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
+        n += got;
+        if (cap - n < 2)
+            buf = fs_realloc(buf, cap *= 2);
+    }
+    fclose(f);
+    buf[n] = '\0';
+    return buf;
+}
+
+/* Loads the preset and applies every override, in the order: file, --set, then dedicated options. */
+static int load_config(const char *arg, const options *o, fs_config *cfg, char **preset_path)
+{
+    *cfg = fs_config_default();
+    *preset_path = fs_preset_find(arg);
+    if (!*preset_path || fs_preset_load(*preset_path, cfg) < 0)
+        return -1;
+    for (int i = 0; i < o->n_sets; i++)
+        if (fs_preset_set(cfg, o->sets[i]) < 0)
+            return -1;
+    if (o->have_seed)
+        cfg->preset.seed = o->seed;
+    if (o->have_size) {
+        cfg->render.width = o->width;
+        cfg->render.height = o->height;
+    }
+    if (o->have_normal)
+        cfg->render.normal = o->normal;
+    return fs_preset_validate(cfg, *preset_path);
+}
+
+/* Writes the selected maps and the sidecar as one atomic output set; prints the final paths. */
+static int write_outputs(const options *o, const fs_config *cfg, const char *name, const char *preset_text,
+                         const fs_result *res, const fs_raster *raster, const fs_maps *maps, double t_start)
+{
+    fs_output *out = fs_output_begin(o->output_dir);
+    if (!out)
+        return -1;
+    const fs_image *images[MAP_COUNT] = {&maps->height, &maps->normal, &maps->basecolor,
+                                         &maps->crackmask, &maps->crackdist, &maps->cellid};
+    fs_image exr_height = {0};
+    fs_sidecar_map list[MAP_COUNT];
+    char files[MAP_COUNT][600];
+    int n = 0;
+    int rc = 0;
+    for (int i = 0; i < MAP_COUNT && rc == 0; i++) {
+        if (!o->maps[i])
+            continue;
+        const fs_image *img = images[i];
+        const char *ext = "png";
+        if (i == MAP_HEIGHT && o->exr) {
+            /* Float height in cm at full precision, straight from the raster. */
+            fs_image_alloc(&exr_height, raster->width, raster->height, 1, FS_PIX_F32);
+            memcpy(exr_height.data, raster->height_cm, fs_image_bytes(&exr_height));
+            img = &exr_height;
+            ext = "exr";
+        }
+        snprintf(files[n], sizeof files[n], "%s_%s.%s", name, map_names[i], ext);
+        rc = fs_image_write(fs_output_stage(out, files[n]), img);
+        list[n] = (fs_sidecar_map){map_names[i], files[n], img, map_color_spaces[i]};
+        n++;
+    }
+    char json_name[600];
+    snprintf(json_name, sizeof json_name, "%s.json", name);
+    if (rc == 0)
+        rc = fs_sidecar_write(fs_output_stage(out, json_name), cfg, preset_text, &res->stats, maps, list, n,
+                              fs_seconds() - t_start);
+    if (rc < 0) {
+        fs_image_free(&exr_height);
+        fs_output_abort(out);
+        return -1;
+    }
+    fs_image_free(&exr_height);
+    if (fs_output_commit(out) < 0)
+        return -1;
+    for (int i = 0; i < n; i++)
+        printf("%s/%s\n", o->output_dir, files[i]);
+    printf("%s/%s\n", o->output_dir, json_name);
+    return 0;
+}
+
+static int run(const char *preset_arg, const options *o)
+{
+    double t_start = fs_seconds();
+    fs_config cfg;
+    char *preset_path = NULL;
+    if (load_config(preset_arg, o, &cfg, &preset_path) < 0) {
+        free(preset_path);
+        return fail();
+    }
+    if (o->dump_preset) {
+        fs_preset_dump(&cfg, stdout);
+        free(preset_path);
+        return 0;
+    }
+    char *preset_text = read_text(preset_path);
+    const char *name = o->name ? o->name : cfg.preset.name;
+    fs_info("%s: %s model on a %s, %d elements, seed %" PRIu64 ", %dx%d maps", preset_path,
+            fs_model_name(cfg.preset.model), fs_domain_type_name(cfg.domain.type), (int)cfg.mesh.elements,
+            cfg.preset.seed, cfg.render.width, cfg.render.height);
+    free(preset_path);
+
+    fs_result res;
+    fs_raster raster = {0};
+    fs_maps maps = {0};
+    int rc = fs_sim_run(&cfg, &res);
+    if (rc == 0) {
+        fs_domain d = cfg.domain;
+        fs_domain_normalize(&d);
+        bool wu = fs_domain_wraps_u(&d), wv = fs_domain_wraps_v(&d);
+        fs_progress("render", -1, "%dx%d, %d triangles", cfg.render.width, cfg.render.height,
+                    (int)res.surface.n_tris);
+        double t_render = fs_seconds();
+        rc = fs_render_raster(&res.surface, cfg.render.width, cfg.render.height, cfg.render.supersample, wu, wv,
+                              &raster);
+        if (rc == 0)
+            rc = fs_maps_build(&raster, &cfg.render, wu, wv, fs_domain_extent_x(&d) / cfg.render.width,
+                               fs_domain_extent_y(&d) / cfg.render.height, &maps);
+        fs_progress_done();
+        fs_debug("rendered in %.2f s", fs_seconds() - t_render);
+        if (rc == 0)
+            rc = write_outputs(o, &cfg, name, preset_text, &res, &raster, &maps, t_start);
+        fs_result_free(&res);
+    }
+    fs_maps_free(&maps);
+    fs_raster_free(&raster);
+    free(preset_text);
+    if (rc < 0)
+        return fail();
+    fs_info("done in %.1f s", fs_seconds() - t_start);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1 && !strcmp(argv[1], "diff"))
+        return fs_cli_diff(argc - 1, argv + 1);
+
+    options o = {.output_dir = "."};
+    for (int i = 0; i < MAP_COUNT; i++)
+        o.maps[i] = true;
+    int rc = parse_options(argc, argv, &o);
+    if (rc != 0) {
+        free(o.sets);
+        return rc < 0 ? 0 : rc;
+    }
+    if (o.list_presets) {
+        free(o.sets);
+        return fs_preset_list(stdout) < 0 ? fail() : 0;
+    }
+    if (optind != argc - 1) {
+        free(o.sets);
+        return usage_error("%s", optind >= argc ? "missing PRESET argument" : "expected exactly one PRESET argument");
+    }
+    rc = run(argv[optind], &o);
+    free(o.sets);
+    return rc;
+}

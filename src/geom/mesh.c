@@ -1,1 +1,668 @@
+/* Triangle meshes on a domain: adjacency, edges, vertex rings, and the Voronoi dual. */
 #include "geom/mesh.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "base/vec.h"
+
+/* Period of the domain along x / y, or 0 in a direction that does not wrap. */
+static double period_x(const fs_mesh *m)
+{
+    bool wraps = m->domain.type == FS_DOMAIN_CYLINDER || (m->domain.type == FS_DOMAIN_PLANE && m->domain.periodic_x);
+    return wraps ? fs_domain_extent_x(&m->domain) : 0.0;
+}
+
+static double period_y(const fs_mesh *m)
+{
+    return m->domain.type != FS_DOMAIN_SPHERE && m->domain.periodic_y ? fs_domain_extent_y(&m->domain) : 0.0;
+}
+
+void fs_mesh_free(fs_mesh *m)
+{
+    free(m->pos);
+    free(m->tri);
+    free(m->shift);
+    free(m->adj);
+    free(m->edge);
+    free(m->edge_tri);
+    free(m->tri_edge);
+    free(m->ring_start);
+    free(m->ring_tri);
+    memset(m, 0, sizeof *m);
+}
+
+void fs_mesh_corner(const fs_mesh *m, int32_t t, int c, double *out)
+{
+    const double *p = m->pos + 3 * (size_t)m->tri[3 * (size_t)t + c];
+    out[0] = p[0];
+    out[1] = p[1];
+    out[2] = p[2];
+    if (m->shift) {
+        const int8_t *s = m->shift + 6 * (size_t)t + 2 * c;
+        if (s[0])
+            out[0] += s[0] * period_x(m);
+        if (s[1])
+            out[1] += s[1] * period_y(m);
+    }
+}
+
+double fs_mesh_tri_area(const fs_mesh *m, int32_t t)
+{
+    double a[3], b[3], c[3];
+    fs_mesh_corner(m, t, 0, a);
+    fs_mesh_corner(m, t, 1, b);
+    fs_mesh_corner(m, t, 2, c);
+    if (m->domain.type != FS_DOMAIN_SPHERE)
+        return 0.5 * fs_orient2(a, b, c);
+    double ab[3], ac[3], n[3], centroid[3];
+    fs_sub3(ab, b, a);
+    fs_sub3(ac, c, a);
+    fs_cross3(n, ab, ac);
+    for (int k = 0; k < 3; k++)
+        centroid[k] = a[k] + b[k] + c[k];
+    double area = 0.5 * fs_norm3(n);
+    return fs_dot3(n, centroid) >= 0.0 ? area : -area;
+}
+
+int32_t fs_mesh_count_boundary_edges(const fs_mesh *m)
+{
+    int32_t count = 0;
+    for (int32_t h = 0; h < 3 * m->n_tris; h++)
+        count += m->adj[h] < 0;
+    return count;
+}
+
+/* Half-edge h = 3 t + i runs from corner i to corner (i + 1) % 3 of triangle t: its nodes, and the
+ * image offset of its end relative to its start (zero off the seams). */
+typedef struct {
+    int32_t from, to;
+    int dx, dy;
+} half_edge;
+
+static half_edge half_edge_of(const fs_mesh *m, int32_t h)
+{
+    int32_t t = h / 3;
+    int i = h % 3, j = (i + 1) % 3;
+    half_edge e = {m->tri[h], m->tri[3 * t + j], 0, 0};
+    if (m->shift) {
+        e.dx = m->shift[6 * t + 2 * j] - m->shift[6 * t + 2 * i];
+        e.dy = m->shift[6 * t + 2 * j + 1] - m->shift[6 * t + 2 * i + 1];
+    }
+    return e;
+}
+
+static bool same_direction(half_edge g, half_edge h)
+{
+    return g.from == h.from && g.to == h.to && g.dx == h.dx && g.dy == h.dy;
+}
+
+static bool opposite(half_edge g, half_edge h)
+{
+    return g.from == h.to && g.to == h.from && g.dx == -h.dx && g.dy == -h.dy;
+}
+
+/* The half-edge running the other way along the same edge, or -1 on a boundary. */
+static int32_t partner(const fs_mesh *m, int32_t h)
+{
+    int32_t u = m->adj[h];
+    if (u < 0)
+        return -1;
+    half_edge e = half_edge_of(m, h);
+    for (int j = 0; j < 3; j++) {
+        int32_t g = 3 * u + j;
+        if (g != h && m->tri[g] == e.to && m->adj[g] == h / 3 && opposite(half_edge_of(m, g), e))
+            return g;
+    }
+    return -1;
+}
+
+/* Half-edges grouped by their start node (counting sort, CSR): start has n_nodes + 1 entries. The
+ * same lists are the corners of each node, in ascending order: half-edge 3 t + c starts at corner c. */
+static void node_half_edges(const fs_mesh *m, int32_t **start_out, int32_t **list_out)
+{
+    int32_t nh = 3 * m->n_tris;
+    int32_t *start = fs_calloc((size_t)m->n_nodes + 1, sizeof *start);
+    for (int32_t h = 0; h < nh; h++)
+        start[m->tri[h] + 1]++;
+    for (int32_t v = 0; v < m->n_nodes; v++)
+        start[v + 1] += start[v];
+    int32_t *fill = fs_malloc(((size_t)m->n_nodes + 1) * sizeof *fill);
+    memcpy(fill, start, ((size_t)m->n_nodes + 1) * sizeof *fill);
+    int32_t *list = fs_malloc((size_t)(nh ? nh : 1) * sizeof *list);
+    for (int32_t h = 0; h < nh; h++)
+        list[fill[m->tri[h]]++] = h;
+    free(fill);
+    *start_out = start;
+    *list_out = list;
+}
+
+/* design: the partner of half-edge a -> b is among the half-edges leaving b (about six), found
+ * through the lists by start node: linear time, no global sort. A second half-edge a -> b in the
+ * same direction means three triangles on one edge or two facing opposite ways. */
+int fs_mesh_build_adjacency(fs_mesh *m)
+{
+    if ((int64_t)m->n_tris * 3 > INT32_MAX) {
+        fs_error(FS_ERR_DATA, "mesh: %d triangles are too many", (int)m->n_tris);
+        return -1;
+    }
+    int32_t nh = 3 * m->n_tris;
+    free(m->adj);
+    m->adj = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->adj);
+    int32_t *start, *list;
+    node_half_edges(m, &start, &list);
+    int32_t *end = fs_malloc((size_t)(nh ? nh : 1) * sizeof *end);
+    for (int32_t h = 0; h < nh; h++)
+        end[h] = m->tri[3 * (h / 3) + (h % 3 + 1) % 3];
+    int rc = 0;
+    for (int32_t h = 0; h < nh && rc == 0; h++) {
+        half_edge e = half_edge_of(m, h);
+        int32_t match = -1, count = 0;
+        for (int32_t k = start[e.to]; k < start[e.to + 1]; k++) {
+            int32_t g = list[k];
+            if (end[g] == e.from && g != h && opposite(half_edge_of(m, g), e)) {
+                match = g;
+                count++;
+            }
+        }
+        for (int32_t k = start[e.from]; k < start[e.from + 1] && count <= 1; k++) {
+            int32_t g = list[k];
+            if (end[g] == e.to && g != h && same_direction(half_edge_of(m, g), e))
+                count = 2;
+        }
+        if (count > 1) {
+            fs_error(FS_ERR_DATA,
+                     "mesh: edge (%d, %d) of triangle %d is shared by more than two triangles or by two facing "
+                     "opposite ways (non-manifold)",
+                     (int)e.from, (int)e.to, (int)(h / 3));
+            rc = -1;
+        }
+        m->adj[h] = match >= 0 ? match / 3 : -1;
+    }
+    free(start);
+    free(list);
+    free(end);
+    return rc;
+}
+
+void fs_mesh_build_edges(fs_mesh *m)
+{
+    int32_t nh = 3 * m->n_tris;
+    free(m->edge);
+    free(m->edge_tri);
+    free(m->tri_edge);
+    m->tri_edge = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->tri_edge);
+    for (int32_t h = 0; h < nh; h++)
+        m->tri_edge[h] = -1;
+    int32_t *edge = fs_malloc((size_t)(nh ? nh : 1) * 2 * sizeof *edge);
+    int32_t *edge_tri = fs_malloc((size_t)(nh ? nh : 1) * 2 * sizeof *edge_tri);
+    int32_t ne = 0;
+    for (int32_t h = 0; h < nh; h++) {
+        if (m->tri_edge[h] >= 0)
+            continue;
+        half_edge e = half_edge_of(m, h);
+        edge[2 * ne] = e.from < e.to ? e.from : e.to;
+        edge[2 * ne + 1] = e.from < e.to ? e.to : e.from;
+        edge_tri[2 * ne] = h / 3;
+        edge_tri[2 * ne + 1] = m->adj[h];
+        m->tri_edge[h] = ne;
+        int32_t g = partner(m, h);
+        if (g >= 0)
+            m->tri_edge[g] = ne;
+        ne++;
+    }
+    m->n_edges = ne;
+    m->edge = fs_realloc(edge, (size_t)(ne ? ne : 1) * 2 * sizeof *edge);
+    m->edge_tri = fs_realloc(edge_tri, (size_t)(ne ? ne : 1) * 2 * sizeof *edge_tri);
+}
+
+/* Corners k = 3 t + c are walked around their node: the next corner counter-clockwise lies across
+ * edge (c + 2) % 3 (-1 at a boundary). The edge clockwise of corner k is half-edge k itself. */
+static int32_t corner_ccw(const fs_mesh *m, int32_t k)
+{
+    return partner(m, 3 * (k / 3) + (k % 3 + 2) % 3);
+}
+
+/* Orders the corners of one node counter-clockwise, fan by fan: first the fans that start at a
+ * boundary edge, then closed fans from their lowest corner. fan_flags marks the first corner of each
+ * fan (1) and whether that fan is open (2). visited has one byte per corner of the mesh. */
+static void walk_node(const fs_mesh *m, const int32_t *corners, int32_t deg, uint8_t *visited, int32_t *out,
+                      uint8_t *fan_flags)
+{
+    int32_t n = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (int32_t i = 0; i < deg && n < deg; i++) {
+            int32_t k = corners[i];
+            if (visited[k] || (pass == 0 && m->adj[k] >= 0))
+                continue;
+            int32_t begin = n, s = k;
+            do {
+                visited[s] = 1;
+                fan_flags[n] = 0;
+                out[n++] = s;
+                s = corner_ccw(m, s);
+            } while (s >= 0 && s != k && !visited[s] && n < deg);
+            fan_flags[begin] = (uint8_t)(1 | (pass == 0 ? 2 : 0));
+        }
+    }
+}
+
+void fs_mesh_build_rings(fs_mesh *m)
+{
+    int32_t *start, *corner;
+    node_half_edges(m, &start, &corner);
+    int32_t nh = 3 * m->n_tris;
+    uint8_t *visited = fs_calloc((size_t)(nh ? nh : 1), 1);
+    int32_t maxdeg = 0;
+    for (int32_t v = 0; v < m->n_nodes; v++)
+        if (start[v + 1] - start[v] > maxdeg)
+            maxdeg = start[v + 1] - start[v];
+    int32_t *order = fs_malloc((size_t)(maxdeg ? maxdeg : 1) * sizeof *order);
+    uint8_t *flags = fs_malloc((size_t)(maxdeg ? maxdeg : 1));
+
+    free(m->ring_start);
+    free(m->ring_tri);
+    m->ring_start = fs_malloc(((size_t)m->n_nodes + 1) * sizeof *m->ring_start);
+    m->ring_tri = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->ring_tri);
+    for (int32_t v = 0; v < m->n_nodes; v++) {
+        int32_t deg = start[v + 1] - start[v];
+        walk_node(m, corner + start[v], deg, visited, order, flags);
+        m->ring_start[v] = start[v];
+        for (int32_t i = 0; i < deg; i++)
+            m->ring_tri[start[v] + i] = order[i] / 3;
+    }
+    m->ring_start[m->n_nodes] = nh;
+    free(order);
+    free(flags);
+    free(visited);
+    free(start);
+    free(corner);
+}
+
+/* ---- Voronoi dual ---- */
+
+/* Circumcentre of the planar triangle (a, b, c); false if it is degenerate. */
+static bool circumcenter2(const double *a, const double *b, const double *c, double *out)
+{
+    double bx = b[0] - a[0], by = b[1] - a[1], cx = c[0] - a[0], cy = c[1] - a[1];
+    double d = 2.0 * (bx * cy - by * cx);
+    if (d == 0.0) {
+        out[0] = (a[0] + b[0] + c[0]) / 3.0;
+        out[1] = (a[1] + b[1] + c[1]) / 3.0;
+        out[2] = 0.0;
+        return false;
+    }
+    double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+    out[0] = a[0] + (cy * b2 - by * c2) / d;
+    out[1] = a[1] + (bx * c2 - cx * b2) / d;
+    out[2] = 0.0;
+    return true;
+}
+
+/* Circumcentre of the 3-D triangle (a, b, c) projected radially onto the sphere of radius r. */
+static void circumcenter_sphere(const double *a, const double *b, const double *c, double r, double *out)
+{
+    double ab[3], ac[3], n[3], u[3], w[3], p[3];
+    fs_sub3(ab, b, a);
+    fs_sub3(ac, c, a);
+    fs_cross3(n, ab, ac);
+    double n2 = fs_dot3(n, n);
+    if (n2 == 0.0) {
+        for (int k = 0; k < 3; k++)
+            p[k] = a[k] + b[k] + c[k];
+    } else {
+        fs_cross3(u, n, ab);
+        fs_cross3(w, ac, n);
+        double ac2 = fs_dot3(ac, ac), ab2 = fs_dot3(ab, ab);
+        for (int k = 0; k < 3; k++)
+            p[k] = a[k] + (ac2 * u[k] + ab2 * w[k]) / (2.0 * n2);
+        /* a circumcentre at the origin (a great-circle triangle) has no projection: use the normal */
+        if (fs_dot3(p, p) <= 1e-24 * ab2)
+            for (int k = 0; k < 3; k++)
+                p[k] = n[k];
+    }
+    double len = fs_norm3(p);
+    for (int k = 0; k < 3; k++)
+        out[k] = len > 0.0 ? p[k] * r / len : 0.0;
+}
+
+/* Signed area of the spherical triangle (a, b, c) on the unit sphere (Van Oosterom and Strackee). */
+static double spherical_triangle_area(const double *a, const double *b, const double *c)
+{
+    double bc[3];
+    fs_cross3(bc, b, c);
+    double triple = fs_dot3(a, bc);
+    double denom = 1.0 + fs_dot3(a, b) + fs_dot3(b, c) + fs_dot3(c, a);
+    return 2.0 * atan2(triple, denom);
+}
+
+/* The clipping box: the domain rectangle in the directions that do not wrap. */
+typedef struct {
+    bool clip[2];
+    double lo[2], hi[2];
+} clip_box;
+
+static clip_box make_box(const fs_mesh *m)
+{
+    clip_box b = {{false, false}, {0.0, 0.0}, {0.0, 0.0}};
+    if (m->domain.type == FS_DOMAIN_SPHERE)
+        return b;
+    b.clip[0] = period_x(m) == 0.0;
+    b.clip[1] = period_y(m) == 0.0;
+    b.hi[0] = fs_domain_extent_x(&m->domain);
+    b.hi[1] = fs_domain_extent_y(&m->domain);
+    return b;
+}
+
+/* Liang-Barsky: the parameter range [t0, t1] of p + t d inside the box (only the clipped
+ * directions). Returns false when the range is empty. */
+static bool clip_line(const clip_box *b, const double *p, const double *d, double *t0, double *t1)
+{
+    for (int k = 0; k < 2; k++) {
+        if (!b->clip[k])
+            continue;
+        if (d[k] == 0.0) {
+            if (p[k] < b->lo[k] || p[k] > b->hi[k])
+                return false;
+            continue;
+        }
+        double ta = (b->lo[k] - p[k]) / d[k], tb = (b->hi[k] - p[k]) / d[k];
+        if (ta > tb) {
+            double s = ta;
+            ta = tb;
+            tb = s;
+        }
+        if (ta > *t0)
+            *t0 = ta;
+        if (tb < *t1)
+            *t1 = tb;
+    }
+    return *t0 < *t1;
+}
+
+/* Sutherland-Hodgman clip of polygon (x, y; n vertices) against one side of the box; writes to
+ * (ox, oy) and returns the new count (at most 2 n). side: 0/1 = lower/upper bound. */
+static int clip_polygon_side(const double *x, const double *y, int n, int axis, int side, double bound, double *ox,
+                             double *oy)
+{
+    int count = 0;
+    for (int i = 0; i < n; i++) {
+        int j = (i + 1) % n;
+        double pi = axis ? y[i] : x[i], pj = axis ? y[j] : x[j];
+        bool in_i = side ? pi <= bound : pi >= bound;
+        bool in_j = side ? pj <= bound : pj >= bound;
+        if (in_i) {
+            ox[count] = x[i];
+            oy[count] = y[i];
+            count++;
+        }
+        if (in_i != in_j) {
+            double s = (bound - pi) / (pj - pi);
+            ox[count] = x[i] + s * (x[j] - x[i]);
+            oy[count] = y[i] + s * (y[j] - y[i]);
+            if (axis)
+                oy[count] = bound;
+            else
+                ox[count] = bound;
+            count++;
+        }
+    }
+    return count;
+}
+
+static double polygon_area(const double *x, const double *y, int n)
+{
+    double s = 0.0;
+    for (int i = 0; i < n; i++) {
+        int j = (i + 1) % n;
+        s += x[i] * y[j] - x[j] * y[i];
+    }
+    return 0.5 * s;
+}
+
+/* Scratch for the cells of the plane and cylinder. */
+typedef struct {
+    double *x, *y, *tx, *ty;
+    int cap;
+} poly_buf;
+
+static void poly_reserve(poly_buf *p, int n)
+{
+    if (n <= p->cap)
+        return;
+    p->cap = 2 * n + 16;
+    p->x = fs_realloc(p->x, (size_t)p->cap * sizeof *p->x);
+    p->y = fs_realloc(p->y, (size_t)p->cap * sizeof *p->y);
+    p->tx = fs_realloc(p->tx, (size_t)p->cap * sizeof *p->tx);
+    p->ty = fs_realloc(p->ty, (size_t)p->cap * sizeof *p->ty);
+}
+
+/* Area of a polygon (relative coordinates, CCW) clipped to the box shifted by -origin. */
+static double clipped_area(poly_buf *p, int n, const clip_box *box, const double *origin)
+{
+    poly_reserve(p, 16 * n + 16);
+    double *x = p->x, *y = p->y, *tx = p->tx, *ty = p->ty;
+    for (int axis = 0; axis < 2 && n > 0; axis++) {
+        if (!box->clip[axis])
+            continue;
+        for (int side = 0; side < 2 && n > 0; side++) {
+            double bound = (side ? box->hi[axis] : box->lo[axis]) - origin[axis];
+            n = clip_polygon_side(x, y, n, axis, side, bound, tx, ty);
+            double *s = x;
+            x = tx;
+            tx = s;
+            s = y;
+            y = ty;
+            ty = s;
+        }
+    }
+    double a = n >= 3 ? polygon_area(x, y, n) : 0.0;
+    p->x = x;
+    p->y = y;
+    p->tx = tx;
+    p->ty = ty;
+    return a;
+}
+
+/* Outward unit normal of the boundary edge from corner i to corner (i + 1) % 3 of triangle t (the
+ * triangle lies to its left), in the frame of t. */
+static void boundary_normal(const fs_mesh *m, int32_t t, int i, double *n)
+{
+    double a[3], b[3];
+    fs_mesh_corner(m, t, i, a);
+    fs_mesh_corner(m, t, (i + 1) % 3, b);
+    double dx = b[0] - a[0], dy = b[1] - a[1], len = hypot(dx, dy);
+    n[0] = len > 0.0 ? dy / len : 0.0;
+    n[1] = len > 0.0 ? -dx / len : 0.0;
+}
+
+/* design: a node's Voronoi cell is the polygon of the circumcentres of its ring, in order (thesis
+ * §5.2). On the plane and cylinder the circumcentres are brought into the node's frame with the
+ * corner shifts; an open fan (a boundary node) is closed by two rays along the outward normals of
+ * its boundary edges, reaching far beyond the domain, and a third far point on their bisector, then
+ * the polygon is clipped to the domain rectangle in the directions that do not wrap (not to the
+ * convex hull), so the cells of points inside the rectangle partition it exactly. On the sphere the
+ * cell is the spherical polygon of the projected circumcentres, summed as signed spherical
+ * triangles from the node: the cells tile the sphere, so the areas sum to 4 pi R^2 to rounding.
+ * Dual edges: the segment between the two circumcentres (sphere: the great-circle arc), clipped like
+ * the cells; a boundary edge has the ray from its triangle's circumcentre along the outward normal,
+ * clipped to the rectangle. */
+int fs_voronoi_build(const fs_mesh *m, fs_voronoi *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!m->ring_start || !m->tri_edge) {
+        fs_error(FS_ERR_INTERNAL, "voronoi: the mesh has no edges or rings (build them first)");
+        return -1;
+    }
+    bool sphere = m->domain.type == FS_DOMAIN_SPHERE;
+    double r = m->domain.radius;
+    double px = period_x(m), py = period_y(m);
+    int32_t nt = m->n_tris;
+    out->circumcenter = fs_malloc((size_t)(nt ? nt : 1) * 3 * sizeof *out->circumcenter);
+    out->cell_area = fs_calloc((size_t)(m->n_nodes ? m->n_nodes : 1), sizeof *out->cell_area);
+    out->edge_length = fs_calloc((size_t)(m->n_edges ? m->n_edges : 1), sizeof *out->edge_length);
+
+    for (int32_t t = 0; t < nt; t++) {
+        double a[3], b[3], c[3];
+        fs_mesh_corner(m, t, 0, a);
+        fs_mesh_corner(m, t, 1, b);
+        fs_mesh_corner(m, t, 2, c);
+        if (sphere)
+            circumcenter_sphere(a, b, c, r, out->circumcenter + 3 * (size_t)t);
+        else
+            circumcenter2(a, b, c, out->circumcenter + 3 * (size_t)t);
+    }
+
+    clip_box box = make_box(m);
+    double diag = sphere ? 0.0 : hypot(fs_domain_extent_x(&m->domain), fs_domain_extent_y(&m->domain));
+
+    int32_t *start, *corner;
+    node_half_edges(m, &start, &corner);
+    int32_t nh = 3 * nt;
+    uint8_t *visited = fs_calloc((size_t)(nh ? nh : 1), 1);
+    int32_t maxdeg = 0;
+    for (int32_t v = 0; v < m->n_nodes; v++)
+        if (start[v + 1] - start[v] > maxdeg)
+            maxdeg = start[v + 1] - start[v];
+    int32_t *order = fs_malloc((size_t)(maxdeg ? maxdeg : 1) * sizeof *order);
+    uint8_t *flags = fs_malloc((size_t)(maxdeg ? maxdeg : 1));
+    poly_buf poly = {NULL, NULL, NULL, NULL, 0};
+
+    for (int32_t v = 0; v < m->n_nodes; v++) {
+        int32_t deg = start[v + 1] - start[v];
+        walk_node(m, corner + start[v], deg, visited, order, flags);
+        const double *pv = m->pos + 3 * (size_t)v;
+        double area = 0.0;
+        for (int32_t f = 0; f < deg;) {
+            int32_t e = f + 1;
+            while (e < deg && !(flags[e] & 1))
+                e++;
+            bool open = (flags[f] & 2) != 0;
+            if (sphere) {
+                double vu[3], cu[3], cn[3];
+                for (int k = 0; k < 3; k++)
+                    vu[k] = pv[k] / r;
+                int32_t last = open ? e - 1 : e;
+                for (int32_t i = f; i < last; i++) {
+                    int32_t ki = order[i], kj = order[i + 1 < e ? i + 1 : f];
+                    for (int k = 0; k < 3; k++) {
+                        cu[k] = out->circumcenter[3 * (ki / 3) + k] / r;
+                        cn[k] = out->circumcenter[3 * (kj / 3) + k] / r;
+                    }
+                    area += r * r * spherical_triangle_area(vu, cu, cn);
+                }
+            } else {
+                int cnt = (int)(e - f);
+                poly_reserve(&poly, 16 * (cnt + 3) + 16);
+                double far = 0.0;
+                for (int32_t i = f; i < e; i++) {
+                    int32_t k = order[i];
+                    int32_t t = (int32_t)(k / 3);
+                    int c = (int)(k % 3);
+                    const int8_t *s = m->shift + 6 * (size_t)t + 2 * c;
+                    const double *cc = out->circumcenter + 3 * (size_t)t;
+                    double x = cc[0] - s[0] * px - pv[0], y = cc[1] - s[1] * py - pv[1];
+                    poly.x[i - f] = x;
+                    poly.y[i - f] = y;
+                    double d = hypot(x, y);
+                    if (d > far)
+                        far = d;
+                }
+                if (open) {
+                    /* rays dual to the two boundary edges, closed far outside the domain */
+                    double n_first[2], n_last[2];
+                    int32_t tf = (int32_t)(order[f] / 3), tl = (int32_t)(order[e - 1] / 3);
+                    boundary_normal(m, tf, (int)(order[f] % 3), n_first);
+                    boundary_normal(m, tl, (int)((order[e - 1] % 3 + 2) % 3), n_last);
+                    double reach = 4.0 * (diag + far) + 1.0;
+                    double ang = atan2(n_last[0] * n_first[1] - n_last[1] * n_first[0],
+                                       n_last[0] * n_first[0] + n_last[1] * n_first[1]);
+                    double cs = cos(0.5 * ang), sn = sin(0.5 * ang);
+                    double bis[2] = {cs * n_last[0] - sn * n_last[1], sn * n_last[0] + cs * n_last[1]};
+                    double xl = poly.x[cnt - 1], yl = poly.y[cnt - 1], xf = poly.x[0], yf = poly.y[0];
+                    poly.x[cnt] = xl + reach * n_last[0];
+                    poly.y[cnt] = yl + reach * n_last[1];
+                    poly.x[cnt + 1] = 2.0 * reach * bis[0];
+                    poly.y[cnt + 1] = 2.0 * reach * bis[1];
+                    poly.x[cnt + 2] = xf + reach * n_first[0];
+                    poly.y[cnt + 2] = yf + reach * n_first[1];
+                    cnt += 3;
+                }
+                area += clipped_area(&poly, cnt, &box, pv);
+            }
+            f = e;
+        }
+        out->cell_area[v] = area;
+    }
+    free(poly.x);
+    free(poly.y);
+    free(poly.tx);
+    free(poly.ty);
+    free(order);
+    free(flags);
+    free(visited);
+    free(start);
+    free(corner);
+
+    for (int32_t e = 0; e < m->n_edges; e++) {
+        int32_t t = m->edge_tri[2 * e], u = m->edge_tri[2 * e + 1];
+        int i = 0;
+        while (i < 2 && m->tri_edge[3 * t + i] != e)
+            i++;
+        int32_t h = 3 * t + i;
+        const double *ct = out->circumcenter + 3 * (size_t)t;
+        double len = 0.0;
+        if (sphere) {
+            double q[3], cr[3];
+            if (u >= 0) {
+                memcpy(q, out->circumcenter + 3 * (size_t)u, sizeof q);
+            } else {
+                double a[3], b[3];
+                fs_mesh_corner(m, t, i, a);
+                fs_mesh_corner(m, t, (i + 1) % 3, b);
+                for (int k = 0; k < 3; k++)
+                    q[k] = 0.5 * (a[k] + b[k]);
+            }
+            fs_cross3(cr, ct, q);
+            len = r * atan2(fs_norm3(cr), fs_dot3(ct, q));
+        } else if (u >= 0) {
+            /* bring u's circumcentre into t's frame through the shared corner */
+            int32_t g = partner(m, h);
+            int ct_corner = i, cu_corner = (int)((g % 3 + 1) % 3);
+            const int8_t *st = m->shift + 6 * (size_t)t + 2 * ct_corner;
+            const int8_t *su = m->shift + 6 * (size_t)u + 2 * cu_corner;
+            const double *cu = out->circumcenter + 3 * (size_t)u;
+            double p0[2] = {ct[0], ct[1]};
+            double d[2] = {cu[0] + (st[0] - su[0]) * px - ct[0], cu[1] + (st[1] - su[1]) * py - ct[1]};
+            double t0 = 0.0, t1 = 1.0;
+            if (clip_line(&box, p0, d, &t0, &t1))
+                len = (t1 - t0) * hypot(d[0], d[1]);
+        } else {
+            double n[2], p0[2] = {ct[0], ct[1]};
+            boundary_normal(m, t, i, n);
+            double t0 = 0.0, t1 = INFINITY;
+            if (clip_line(&box, p0, n, &t0, &t1)) {
+                if (isfinite(t1)) {
+                    len = t1 - t0;
+                } else {
+                    double a[3], b[3];
+                    fs_mesh_corner(m, t, i, a);
+                    fs_mesh_corner(m, t, (i + 1) % 3, b);
+                    len = hypot(0.5 * (a[0] + b[0]) - ct[0], 0.5 * (a[1] + b[1]) - ct[1]);
+                }
+            }
+        }
+        out->edge_length[e] = len;
+    }
+    return 0;
+}
+
+void fs_voronoi_free(fs_voronoi *v)
+{
+    free(v->circumcenter);
+    free(v->cell_area);
+    free(v->edge_length);
+    memset(v, 0, sizeof *v);
+}

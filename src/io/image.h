@@ -47,11 +47,13 @@ typedef struct {
 int fs_image_compare(const fs_image *a, const fs_image *b, fs_image_diff *out);
 
 /* Euclidean distance (pixels) from each pixel to the nearest pixel with mask != 0; wraps on the
- * given axes so that distances continue across the seam. dist has width * height floats. */
+ * given axes so that distances continue across the seam. dist has width * height floats (+inf
+ * everywhere when the mask is empty). Returns 0, or -1 with fs_error(FS_ERR_INTERNAL). */
 int fs_image_distance(const uint8_t *mask, int width, int height, bool wrap_u, bool wrap_v, float *dist);
 
-/* Area-averaging resize of a float single-channel buffer (used for supersampling). */
-void fs_image_downsample(const float *src, int src_w, int src_h, float *dst, int dst_w, int dst_h);
+/* Area-averaging resize of a float single-channel buffer (used for supersampling).
+ * Returns 0, or -1 with fs_error(FS_ERR_INTERNAL). */
+int fs_image_downsample(const float *src, int src_w, int src_h, float *dst, int dst_w, int dst_h);
 
 #ifdef __cplusplus
 }

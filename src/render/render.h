@@ -45,7 +45,13 @@ int32_t fs_render_mesh_add_vertex(fs_render_mesh *m, double u, double v, double 
 void fs_render_mesh_add_tri(fs_render_mesh *m, int32_t a, int32_t b, int32_t c);
 void fs_render_mesh_free(fs_render_mesh *m);
 
-/* Per-pixel results of a render, area-averaged over the supersamples except cell (centre sample). */
+/* Per-pixel results of a render, area-averaged over the supersamples except cell (centre sample).
+ * Pixel convention (all rasters and maps): pixel (i, j) is column i from the left and row j from the
+ * top, stored at j * width + i; it covers u in [i/W, (i+1)/W] and v in [1 - (j+1)/H, 1 - j/H], with
+ * its centre at u = (i + 0.5)/W, v = 1 - (j + 0.5)/H. So u grows to the right and v grows towards
+ * the TOP of the image, which is the +Y (green) direction of an OpenGL normal map.
+ * Samples where no triangle was drawn are exposed background: height 0, crack 1, cell 0, shade 0.
+ * With an even supersample, "the centre sample" is the one just right of and below the centre. */
 typedef struct {
     int width, height;
     float *height_cm; /* cm; background (0) where nothing was drawn */
@@ -59,12 +65,20 @@ typedef struct {
  * Returns 0, or -1 with fs_error(FS_ERR_INTERNAL) when OSMesa cannot be set up. */
 int fs_render_raster(const fs_render_mesh *m, int width, int height, int supersample, bool wrap_u,
                      bool wrap_v, fs_raster *out);
+
+/* fs_render_raster with an explicit tile limit: tiles hold at most tile_samples x tile_samples
+ * supersamples (fs_render_raster uses FS_RENDER_TILE_SAMPLES). The result does not depend on the
+ * tiling except for float rounding in interpolated attributes; exposed for tests. */
+#define FS_RENDER_TILE_SAMPLES 2048
+int fs_render_raster_tiled(const fs_render_mesh *m, int width, int height, int supersample, bool wrap_u,
+                           bool wrap_v, int tile_samples, fs_raster *out);
 void fs_raster_free(fs_raster *r);
 
 /* The texture maps of SPEC §6 built from a raster. */
 typedef struct {
     fs_image height;     /* 1 x u16, linear, 0 = lowest */
-    fs_image normal;     /* 3 x u8 RGB tangent-space normal */
+    fs_image normal;     /* 3 x u8 RGB tangent-space normal, n * 0.5 + 0.5; green is +v (up the
+                          * image) for OpenGL, -v for DirectX */
     fs_image basecolor;  /* 3 x u8 RGB sRGB */
     fs_image crackmask;  /* 1 x u8, 255 = crack */
     fs_image crackdist;  /* 1 x u16, distance to the nearest crack in pixels * crackdist_scale */

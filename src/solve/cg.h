@@ -1,0 +1,29 @@
+/* Jacobi-preconditioned conjugate gradients: the iterative baseline for the equilibrium solves (thesis §5.4). */
+#ifndef FS_SOLVE_CG_H
+#define FS_SOLVE_CG_H
+
+#include <stdint.h>
+
+#include "solve/sparse.h"
+
+/* Stopping rule of fs_cg_solve. */
+typedef struct {
+    double tolerance;       /* stop when ||b - A x|| <= tolerance ||b|| (Euclidean norms) */
+    int32_t max_iterations; /* give up after this many iterations; <= 0 means n */
+} fs_cg_params;
+
+/* tolerance 1e-8, max_iterations 0 (that is, n). */
+fs_cg_params fs_cg_params_default(void);
+
+/* Solves A x = b for the symmetric positive definite matrix whose upper triangle a stores, by conjugate
+ * gradients preconditioned with diag(A). x holds the starting guess on entry (zeros, or the previous
+ * step's solution) and the solution on return; b and x have a->n elements and must not overlap.
+ * Convergence is judged on the true residual, recomputed when the recurrence claims convergence. If
+ * relative_residual is not NULL it receives the final ||b - A x|| / ||b||. Scratch memory (4n doubles) is
+ * allocated per call. Returns the number of iterations (0 if the guess already satisfies the tolerance;
+ * x = 0 if b = 0), or -1 with FS_ERR_INTERNAL: "cg: no convergence after N iterations (relative residual
+ * r)", or when a diagonal entry or a curvature p'Ap is not positive (A is not positive definite). */
+int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_params params,
+                double *relative_residual);
+
+#endif

@@ -1,0 +1,509 @@
+/* Sparse symmetric assembly and products, and the only CHOLMOD user: sparse Cholesky for the equilibrium solves. */
+#include "solve/sparse.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include <cholmod.h>
+
+#include "base/error.h"
+
+_Static_assert(sizeof(int) == sizeof(int32_t), "the int interface of CHOLMOD reads our int32_t arrays");
+
+void fs_sparse_builder_init(fs_sparse_builder *b, int32_t n, size_t capacity_hint)
+{
+    FS_ASSERT(n >= 0);
+    b->n = n;
+    b->count = 0;
+    b->capacity = capacity_hint;
+    b->rows = fs_malloc(capacity_hint * sizeof *b->rows);
+    b->cols = fs_malloc(capacity_hint * sizeof *b->cols);
+    b->values = fs_malloc(capacity_hint * sizeof *b->values);
+}
+
+void fs_sparse_builder_free(fs_sparse_builder *b)
+{
+    free(b->rows);
+    free(b->cols);
+    free(b->values);
+    memset(b, 0, sizeof *b);
+}
+
+void fs_sparse_builder_clear(fs_sparse_builder *b) { b->count = 0; }
+
+static void builder_reserve(fs_sparse_builder *b, size_t extra)
+{
+    if (b->count + extra <= b->capacity)
+        return;
+    size_t capacity = b->capacity ? b->capacity : 64;
+    while (capacity < b->count + extra)
+        capacity *= 2;
+    b->rows = fs_realloc(b->rows, capacity * sizeof *b->rows);
+    b->cols = fs_realloc(b->cols, capacity * sizeof *b->cols);
+    b->values = fs_realloc(b->values, capacity * sizeof *b->values);
+    b->capacity = capacity;
+}
+
+size_t fs_sparse_builder_add(fs_sparse_builder *b, int32_t row, int32_t col, double value)
+{
+    FS_ASSERT(row >= 0 && row < b->n && col >= 0 && col < b->n);
+    builder_reserve(b, 1);
+    size_t e = b->count++;
+    b->rows[e] = row < col ? row : col;
+    b->cols[e] = row < col ? col : row;
+    b->values[e] = value;
+    return e;
+}
+
+int32_t fs_sparse_builder_add_block(fs_sparse_builder *b, int32_t k, const int32_t *idx, const double *ke)
+{
+    FS_ASSERT(k >= 0);
+    builder_reserve(b, (size_t)k * (size_t)(k + 1) / 2);
+    int32_t added = 0;
+    for (int32_t a = 0; a < k; a++) {
+        if (idx[a] < 0)
+            continue;
+        for (int32_t c = a; c < k; c++) {
+            if (idx[c] < 0)
+                continue;
+            FS_ASSERT(a == c || idx[a] != idx[c]);
+            fs_sparse_builder_add(b, idx[a], idx[c], ke[(size_t)a * (size_t)k + (size_t)c]);
+            added++;
+        }
+    }
+    return added;
+}
+
+/* design: two stable counting sorts, by row and then by column, leave each column's entries in increasing
+ * row order with the entries of one (row, column) pair in entry order; merging runs of equal rows then
+ * sums duplicates in entry order, which fs_sparse_matrix_add_block repeats exactly. O(n + count). */
+int fs_sparse_builder_compress(const fs_sparse_builder *b, fs_sparse_matrix *out, int32_t *slots)
+{
+    int32_t n = b->n;
+    size_t count = b->count;
+    size_t *start = fs_calloc((size_t)n + 1, sizeof *start);
+    size_t *by_row = fs_malloc(count * sizeof *by_row);
+    size_t *order = fs_malloc(count * sizeof *order);
+
+    for (size_t e = 0; e < count; e++)
+        start[b->rows[e] + 1]++;
+    for (int32_t i = 0; i < n; i++)
+        start[i + 1] += start[i];
+    for (size_t e = 0; e < count; e++)
+        by_row[start[b->rows[e]]++] = e;
+
+    memset(start, 0, ((size_t)n + 1) * sizeof *start);
+    for (size_t e = 0; e < count; e++)
+        start[b->cols[e] + 1]++;
+    for (int32_t j = 0; j < n; j++)
+        start[j + 1] += start[j];
+    size_t *cursor = fs_malloc(((size_t)n + 1) * sizeof *cursor);
+    memcpy(cursor, start, ((size_t)n + 1) * sizeof *cursor);
+    for (size_t k = 0; k < count; k++) {
+        size_t e = by_row[k];
+        order[cursor[b->cols[e]]++] = e;
+    }
+    free(cursor);
+    free(by_row);
+
+    size_t nnz = 0;
+    for (int32_t j = 0; j < n; j++) {
+        int32_t last = -1;
+        for (size_t k = start[j]; k < start[j + 1]; k++) {
+            int32_t r = b->rows[order[k]];
+            if (r != last)
+                nnz++;
+            last = r;
+        }
+        if (last != j)
+            nnz++;
+    }
+    if (nnz > (size_t)INT32_MAX) {
+        free(start);
+        free(order);
+        fs_error(FS_ERR_INTERNAL, "sparse: %zu stored entries exceed the 32-bit index range", nnz);
+        return -1;
+    }
+
+    out->n = n;
+    out->col_ptr = fs_malloc(((size_t)n + 1) * sizeof *out->col_ptr);
+    out->row_idx = fs_malloc(nnz * sizeof *out->row_idx);
+    out->values = fs_malloc(nnz * sizeof *out->values);
+    int32_t p = 0;
+    for (int32_t j = 0; j < n; j++) {
+        out->col_ptr[j] = p;
+        int32_t last = -1;
+        for (size_t k = start[j]; k < start[j + 1]; k++) {
+            size_t e = order[k];
+            int32_t r = b->rows[e];
+            if (r != last) {
+                out->row_idx[p] = r;
+                out->values[p] = 0.0;
+                p++;
+                last = r;
+            }
+            out->values[p - 1] += b->values[e];
+            if (slots)
+                slots[e] = p - 1;
+        }
+        if (last != j) {
+            out->row_idx[p] = j;
+            out->values[p] = 0.0;
+            p++;
+        }
+    }
+    out->col_ptr[n] = p;
+    free(start);
+    free(order);
+    return 0;
+}
+
+void fs_sparse_matrix_free(fs_sparse_matrix *m)
+{
+    free(m->col_ptr);
+    free(m->row_idx);
+    free(m->values);
+    memset(m, 0, sizeof *m);
+}
+
+void fs_sparse_matrix_zero(fs_sparse_matrix *m)
+{
+    int32_t nnz = fs_sparse_matrix_nnz(m);
+    for (int32_t p = 0; p < nnz; p++)
+        m->values[p] = 0.0;
+}
+
+int32_t fs_sparse_matrix_add_block(fs_sparse_matrix *m, int32_t k, const int32_t *idx, const double *ke,
+                                   const int32_t *slots)
+{
+    int32_t used = 0;
+    for (int32_t a = 0; a < k; a++) {
+        if (idx[a] < 0)
+            continue;
+        for (int32_t c = a; c < k; c++) {
+            if (idx[c] < 0)
+                continue;
+            m->values[slots[used++]] += ke[(size_t)a * (size_t)k + (size_t)c];
+        }
+    }
+    return used;
+}
+
+void fs_sparse_matvec(const fs_sparse_matrix *m, const double *x, double *y)
+{
+    int32_t n = m->n;
+    for (int32_t i = 0; i < n; i++)
+        y[i] = 0.0;
+    for (int32_t j = 0; j < n; j++) {
+        double xj = x[j];
+        double yj = 0.0;
+        for (int32_t p = m->col_ptr[j]; p < m->col_ptr[j + 1]; p++) {
+            int32_t i = m->row_idx[p];
+            double v = m->values[p];
+            if (i == j) {
+                yj += v * xj;
+            } else {
+                y[i] += v * xj;
+                yj += v * x[i];
+            }
+        }
+        y[j] += yj;
+    }
+}
+
+struct fs_cholesky {
+    cholmod_common common;     /* CHOLMOD's settings, statistics and workspace; one per object */
+    cholmod_factor *factor;    /* the factor being used: symbolic until the first factorization */
+    cholmod_factor *symbolic;  /* the analysis as it came, restored when factor no longer matches it */
+    int32_t n;                 /* order of the analysed matrix */
+    int32_t nnz;               /* stored entries of the analysed matrix (a cheap pattern check) */
+    int32_t *inverse_perm;     /* inverse_perm[i]: position of unknown i in CHOLMOD's ordering */
+    double factor_nonzeros;    /* nnz(L) predicted by the analysis (later calls overwrite common's copy) */
+    double flops;              /* flop count of one factorization, from the analysis */
+    int valid;                 /* factor holds a successful numeric factorization */
+    int stale;                 /* factor differs from symbolic in kind (after updown or a failure) */
+    cholmod_dense *solve_y;    /* solve workspace kept between calls */
+    cholmod_dense *solve_e;    /* solve workspace kept between calls */
+};
+
+/* CHOLMOD reports through a plain function pointer without user data, so the last message of this
+ * thread is kept here and read by the wrapper that made the call. */
+static _Thread_local char cholmod_message[256];
+
+static void store_cholmod_message(int status, const char *file, int line, const char *message)
+{
+    (void)file;
+    (void)line;
+    snprintf(cholmod_message, sizeof cholmod_message, "%s (status %d)", message ? message : "", status);
+}
+
+static const char *cholmod_status_name(int status)
+{
+    switch (status) {
+    case CHOLMOD_NOT_INSTALLED: return "method not installed";
+    case CHOLMOD_OUT_OF_MEMORY: return "out of memory";
+    case CHOLMOD_TOO_LARGE: return "integer overflow";
+    case CHOLMOD_INVALID: return "invalid input";
+    case CHOLMOD_GPU_PROBLEM: return "GPU failure";
+    case CHOLMOD_NOT_POSDEF: return "matrix not positive definite";
+    default: return "unknown status";
+    }
+}
+
+static void report_failure(const fs_cholesky *c, const char *what)
+{
+    if (cholmod_message[0])
+        fs_error(FS_ERR_INTERNAL, "cholmod: %s failed: %s", what, cholmod_message);
+    else
+        fs_error(FS_ERR_INTERNAL, "cholmod: %s failed: %s (status %d)", what,
+                 cholmod_status_name(c->common.status), c->common.status);
+}
+
+/* A header over the caller's arrays (upper triangle, sorted, packed): CHOLMOD reads them in place. */
+static cholmod_sparse wrap_matrix(const fs_sparse_matrix *a)
+{
+    cholmod_sparse s;
+    memset(&s, 0, sizeof s);
+    s.nrow = (size_t)a->n;
+    s.ncol = (size_t)a->n;
+    s.nzmax = (size_t)fs_sparse_matrix_nnz(a);
+    s.p = a->col_ptr;
+    s.i = a->row_idx;
+    s.x = a->values;
+    s.stype = 1;
+    s.itype = CHOLMOD_INT;
+    s.xtype = CHOLMOD_REAL;
+    s.dtype = CHOLMOD_DOUBLE;
+    s.sorted = 1;
+    s.packed = 1;
+    return s;
+}
+
+void fs_cholesky_free(fs_cholesky *c)
+{
+    if (!c)
+        return;
+    cholmod_free_factor(&c->factor, &c->common);
+    cholmod_free_factor(&c->symbolic, &c->common);
+    cholmod_free_dense(&c->solve_y, &c->common);
+    cholmod_free_dense(&c->solve_e, &c->common);
+    cholmod_finish(&c->common);
+    free(c->inverse_perm);
+    free(c);
+}
+
+fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a)
+{
+    fs_cholesky *c = fs_calloc(1, sizeof *c);
+    cholmod_message[0] = '\0';
+    if (!cholmod_start(&c->common)) {
+        report_failure(c, "start");
+        free(c);
+        return NULL;
+    }
+    c->common.print = 0;
+    c->common.error_handler = store_cholmod_message;
+    c->common.quick_return_if_not_posdef = 1;
+    /* A simplicial LDL' factorization accepts indefinite matrices with nonzero pivots; LL' stops at the
+     * first non-positive pivot, which is the test we want. */
+    c->common.final_ll = 1;
+    c->n = a->n;
+    c->nnz = fs_sparse_matrix_nnz(a);
+
+    cholmod_sparse view = wrap_matrix(a);
+    c->factor = cholmod_analyze(&view, &c->common);
+    if (!c->factor || c->common.status < CHOLMOD_OK) {
+        report_failure(c, "analyze");
+        fs_cholesky_free(c);
+        return NULL;
+    }
+    c->symbolic = cholmod_copy_factor(c->factor, &c->common);
+    if (!c->symbolic) {
+        report_failure(c, "copy_factor");
+        fs_cholesky_free(c);
+        return NULL;
+    }
+    c->factor_nonzeros = c->common.lnz;
+    c->flops = c->common.fl;
+    const int *perm = c->factor->Perm;
+    c->inverse_perm = fs_malloc(((size_t)a->n + 1) * sizeof *c->inverse_perm);
+    for (int32_t k = 0; k < a->n; k++)
+        c->inverse_perm[perm[k]] = k;
+    return c;
+}
+
+/* Puts the symbolic analysis back as the factor, after an update changed the factor's kind or a failed
+ * factorization left it half-written. */
+static int restore_symbolic(fs_cholesky *c)
+{
+    cholmod_free_factor(&c->factor, &c->common);
+    c->factor = cholmod_copy_factor(c->symbolic, &c->common);
+    if (!c->factor) {
+        report_failure(c, "copy_factor");
+        return -1;
+    }
+    c->stale = 0;
+    return 0;
+}
+
+int fs_cholesky_factorize(fs_cholesky *c, const fs_sparse_matrix *a)
+{
+    FS_ASSERT(a->n == c->n && fs_sparse_matrix_nnz(a) == c->nnz);
+    c->valid = 0;
+    cholmod_message[0] = '\0';
+    if (c->stale && restore_symbolic(c) != 0)
+        return -1;
+
+    cholmod_sparse view = wrap_matrix(a);
+    int ok = cholmod_factorize(&view, c->factor, &c->common);
+    if (c->common.status == CHOLMOD_NOT_POSDEF) {
+        size_t minor = c->factor->minor;
+        const int *perm = c->factor->Perm;
+        c->stale = 1;
+        fs_error(FS_ERR_INTERNAL, "cholmod: matrix not positive definite at column %d",
+                 minor < (size_t)c->n ? perm[minor] : -1);
+        return -1;
+    }
+    if (!ok || c->common.status < CHOLMOD_OK) {
+        c->stale = 1;
+        report_failure(c, "factorize");
+        return -1;
+    }
+    c->valid = 1;
+    return 0;
+}
+
+/* design: the right-hand sides and the solution are dense headers over the caller's arrays. CHOLMOD's
+ * cholmod_solve2 keeps a solution matrix that already has the requested size, type and leading dimension
+ * (cholmod_ensure_dense), so x is written in place; b is only read. */
+int fs_cholesky_solve(fs_cholesky *c, int32_t nrhs, const double *b, double *x)
+{
+    FS_ASSERT(nrhs >= 0);
+    if (!c->valid) {
+        fs_error(FS_ERR_INTERNAL, "cholmod: solve without a valid factorization");
+        return -1;
+    }
+    if (nrhs == 0 || c->n == 0)
+        return 0;
+    cholmod_dense rhs, sol;
+    memset(&rhs, 0, sizeof rhs);
+    rhs.nrow = (size_t)c->n;
+    rhs.ncol = (size_t)nrhs;
+    rhs.nzmax = (size_t)c->n * (size_t)nrhs;
+    rhs.d = (size_t)c->n;
+    rhs.x = (void *)b;
+    rhs.xtype = CHOLMOD_REAL;
+    rhs.dtype = CHOLMOD_DOUBLE;
+    sol = rhs;
+    sol.x = x;
+    cholmod_dense *solution = &sol;
+
+    cholmod_message[0] = '\0';
+    int ok = cholmod_solve2(CHOLMOD_A, c->factor, &rhs, NULL, &solution, NULL, &c->solve_y, &c->solve_e,
+                            &c->common);
+    FS_ASSERT(solution == &sol);
+    if (!ok || c->common.status < CHOLMOD_OK) {
+        report_failure(c, "solve");
+        return -1;
+    }
+    return 0;
+}
+
+/* Sorts one column of C by row (columns of an update are short), carrying the values along. */
+static void sort_column(int *rows, double *values, int32_t len)
+{
+    for (int32_t k = 1; k < len; k++) {
+        int r = rows[k];
+        double v = values[k];
+        int32_t m = k;
+        while (m > 0 && rows[m - 1] > r) {
+            rows[m] = rows[m - 1];
+            values[m] = values[m - 1];
+            m--;
+        }
+        rows[m] = r;
+        values[m] = v;
+    }
+    for (int32_t k = 1; k < len; k++)
+        FS_ASSERT(rows[k] != rows[k - 1]);
+}
+
+/* The first column (in CHOLMOD's order) whose pivot D(j,j) of a simplicial LDL' factor is not positive, or
+ * -1. cholmod_updown leaves such a factor and does not judge the sign of D, so a downdate that removes
+ * more than the matrix holds is caught here; the diagonal is the first entry of each column. */
+static int32_t ldl_first_nonpositive_pivot(const cholmod_factor *f)
+{
+    FS_ASSERT(!f->is_super && !f->is_ll);
+    const int *lp = f->p;
+    const double *lx = f->x;
+    for (size_t j = 0; j < f->n; j++)
+        if (!(lx[lp[j]] > 0.0))
+            return (int32_t)j;
+    return -1;
+}
+
+/* design: CHOLMOD factors P A P', so W is permuted into C = P W (row i of W becomes row inverse_perm[i])
+ * and each column sorted, as cholmod_updown requires. */
+int fs_cholesky_updown(fs_cholesky *c, int sign, int32_t rank, const int32_t *col_ptr,
+                       const int32_t *row_idx, const double *values)
+{
+    FS_ASSERT(rank >= 0 && sign != 0);
+    if (!c->valid) {
+        fs_error(FS_ERR_INTERNAL, "cholmod: update without a valid factorization");
+        return -1;
+    }
+    if (rank == 0)
+        return 0;
+    int32_t nz = col_ptr[rank] - col_ptr[0];
+    cholmod_message[0] = '\0';
+    cholmod_sparse *w = cholmod_allocate_sparse((size_t)c->n, (size_t)rank, (size_t)nz, 1, 1, 0,
+                                                CHOLMOD_REAL, &c->common);
+    if (!w) {
+        report_failure(c, "allocate_sparse");
+        return -1;
+    }
+    int *wp = w->p;
+    int *wi = w->i;
+    double *wx = w->x;
+    for (int32_t j = 0; j <= rank; j++)
+        wp[j] = col_ptr[j] - col_ptr[0];
+    for (int32_t p = 0; p < nz; p++) {
+        int32_t i = row_idx[col_ptr[0] + p];
+        FS_ASSERT(i >= 0 && i < c->n);
+        wi[p] = c->inverse_perm[i];
+        wx[p] = values[col_ptr[0] + p];
+    }
+    for (int32_t j = 0; j < rank; j++)
+        sort_column(wi + wp[j], wx + wp[j], wp[j + 1] - wp[j]);
+
+    int ok = cholmod_updown(sign > 0, w, c->factor, &c->common);
+    cholmod_free_sparse(&w, &c->common);
+    c->stale = 1;
+    if (!ok || c->common.status < CHOLMOD_OK) {
+        c->valid = 0;
+        report_failure(c, "updown");
+        return -1;
+    }
+    int32_t column = ldl_first_nonpositive_pivot(c->factor);
+    if (column >= 0) {
+        const int *perm = c->factor->Perm;
+        c->valid = 0;
+        fs_error(FS_ERR_INTERNAL, "cholmod: matrix not positive definite at column %d after downdate",
+                 perm[column]);
+        return -1;
+    }
+    return 0;
+}
+
+fs_cholesky_info fs_cholesky_get_info(const fs_cholesky *c)
+{
+    static const char *const names[] = {"natural", "given", "amd", "metis", "nesdis", "colamd", "postordered"};
+    const cholmod_factor *f = c->symbolic;
+    fs_cholesky_info info;
+    info.n = c->n;
+    info.factor_nonzeros = c->factor_nonzeros;
+    info.flops = c->flops;
+    info.supernodal = f->is_super ? 1 : 0;
+    info.ordering = f->ordering >= 0 && f->ordering <= 6 ? names[f->ordering] : "unknown";
+    return info;
+}

@@ -1,0 +1,499 @@
+/* Tests of the shared fracture kernels: eigen decomposition, principal stresses, ranking, event search. */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "base/rng.h"
+#include "check.h"
+#include "fracture/eigen.h"
+#include "fracture/event.h"
+#include "fracture/rank.h"
+
+/* ---- eigen ---- */
+
+/* Largest |a - V diag(l) V^T| entry, with vectors + 3k the k-th eigenvector. */
+static double reconstruction_error(const double a[9], const double l[3], const double v[9])
+{
+    double worst = 0.0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double sum = 0.0;
+            for (int k = 0; k < 3; k++)
+                sum += v[3 * k + i] * l[k] * v[3 * k + j];
+            worst = fmax(worst, fabs(sum - a[3 * i + j]));
+        }
+    return worst;
+}
+
+/* Largest |V^T V - I| entry. */
+static double orthonormality_error(const double v[9])
+{
+    double worst = 0.0;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+            double dot = v[3 * a] * v[3 * b] + v[3 * a + 1] * v[3 * b + 1] + v[3 * a + 2] * v[3 * b + 2];
+            worst = fmax(worst, fabs(dot - (a == b ? 1.0 : 0.0)));
+        }
+    return worst;
+}
+
+static int same9(const double a[9], const double b[9])
+{
+    for (int k = 0; k < 9; k++)
+        if (a[k] != b[k])
+            return 0;
+    return 1;
+}
+
+static double det3(const double v[9])
+{
+    return v[0] * (v[4] * v[8] - v[5] * v[7]) - v[1] * (v[3] * v[8] - v[5] * v[6]) +
+           v[2] * (v[3] * v[7] - v[4] * v[6]);
+}
+
+/* A random rotation Q (rows orthonormal, det +1) from a random unit quaternion. */
+static void random_rotation(uint64_t index, double q[9])
+{
+    double w = fs_rand_normal(21, FS_RNG_TEST, 4 * index), x = fs_rand_normal(21, FS_RNG_TEST, 4 * index + 1);
+    double y = fs_rand_normal(21, FS_RNG_TEST, 4 * index + 2), z = fs_rand_normal(21, FS_RNG_TEST, 4 * index + 3);
+    double n = sqrt(w * w + x * x + y * y + z * z);
+    w /= n, x /= n, y /= n, z /= n;
+    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                         2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                         2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
+    memcpy(q, r, sizeof r);
+}
+
+/* a = Q^T diag(l) Q: the rows of Q are the eigenvectors. */
+static void compose(const double q[9], const double l[3], double a[9])
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double sum = 0.0;
+            for (int k = 0; k < 3; k++)
+                sum += q[3 * k + i] * l[k] * q[3 * k + j];
+            a[3 * i + j] = sum;
+        }
+}
+
+/* The checks every decomposition must pass: sorted, orthonormal, right-handed, reconstructs a. */
+static void check_decomposition(const double a[9], double tol)
+{
+    double l[3], v[9];
+    CHECK(fs_eigen_sym3(a, l, v) == 0);
+    CHECK(l[0] >= l[1] && l[1] >= l[2]);
+    CHECK_NEAR(orthonormality_error(v), 0.0, 1e-14);
+    CHECK_NEAR(det3(v), 1.0, 1e-14);
+    CHECK_NEAR(reconstruction_error(a, l, v), 0.0, tol);
+}
+
+static void test_eigen_random(void)
+{
+    double worst = 0.0;
+    for (uint64_t m = 0; m < 2000; m++) {
+        double a[9];
+        for (int i = 0; i < 3; i++)
+            for (int j = i; j < 3; j++)
+                a[3 * i + j] = a[3 * j + i] = fs_rand_range(7, FS_RNG_TEST, 9 * m + 3 * (uint64_t)i + (uint64_t)j, -1, 1);
+        double l[3], v[9];
+        CHECK(fs_eigen_sym3(a, l, v) == 0);
+        CHECK(l[0] >= l[1] && l[1] >= l[2]);
+        worst = fmax(worst, reconstruction_error(a, l, v));
+        worst = fmax(worst, orthonormality_error(v));
+        CHECK_NEAR(det3(v), 1.0, 1e-14);
+        /* Trace and determinant are invariants. */
+        CHECK_NEAR(l[0] + l[1] + l[2], a[0] + a[4] + a[8], 1e-14);
+        CHECK_NEAR(l[0] * l[1] * l[2], det3(a), 1e-14);
+    }
+    CHECK_MSG(worst < 1e-12, "worst error %g", worst);
+    /* Scale does not matter: the same matrices at 1e150 and 1e-150. */
+    for (uint64_t m = 0; m < 50; m++) {
+        double a[9], big[9], tiny[9];
+        for (int i = 0; i < 3; i++)
+            for (int j = i; j < 3; j++)
+                a[3 * i + j] = a[3 * j + i] = fs_rand_range(8, FS_RNG_TEST, 9 * m + 3 * (uint64_t)i + (uint64_t)j, -1, 1);
+        for (int k = 0; k < 9; k++) {
+            big[k] = a[k] * 1e150;
+            tiny[k] = a[k] * 1e-150;
+        }
+        check_decomposition(big, 1e-12 * 1e150);
+        check_decomposition(tiny, 1e-12 * 1e-150);
+    }
+}
+
+static void test_eigen_prescribed(void)
+{
+    /* Known spectra, including repeated and nearly repeated eigenvalues, in random orientations. */
+    static const double spectra[][3] = {{3, 1, -2}, {1, 1, -2}, {4, -1, -1}, {2, 2, 2},
+                                        {1 + 1e-13, 1, 0.5}, {1e-9, 0, -1e-9}, {1e6, 1, 1e-6}};
+    for (uint64_t k = 0; k < sizeof spectra / sizeof spectra[0]; k++)
+        for (uint64_t rot = 0; rot < 40; rot++) {
+            double q[9], a[9], l[3], v[9];
+            random_rotation(40 * k + rot, q);
+            compose(q, spectra[k], a);
+            double scale = fabs(spectra[k][0]) + fabs(spectra[k][2]);
+            CHECK(fs_eigen_sym3(a, l, v) == 0);
+            for (int i = 0; i < 3; i++)
+                CHECK_NEAR(l[i], spectra[k][i], 1e-14 * scale);
+            check_decomposition(a, 1e-14 * scale);
+            /* A simple eigenvalue's vector is the prescribed one up to sign. */
+            if (spectra[k][0] - spectra[k][1] > 1e-3 * scale)
+                CHECK_NEAR(fabs(v[0] * q[0] + v[1] * q[1] + v[2] * q[2]), 1.0, 1e-12);
+        }
+}
+
+static void test_eigen_exact_cases(void)
+{
+    double l[3], v[9];
+    const double diag[9] = {2, 0, 0, 0, -1, 0, 0, 0, 5};
+    CHECK(fs_eigen_sym3(diag, l, v) == 0);
+    CHECK(l[0] == 5 && l[1] == 2 && l[2] == -1);
+    const double want[9] = {0, 0, 1, 1, 0, 0, 0, 1, 0}; /* e_z, e_x, e_z x e_x = e_y */
+    CHECK(same9(v, want));
+
+    const double repeated[9] = {3, 0, 0, 0, 3, 0, 0, 0, 3};
+    CHECK(fs_eigen_sym3(repeated, l, v) == 0);
+    CHECK(l[0] == 3 && l[1] == 3 && l[2] == 3);
+    const double ident[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    CHECK(same9(v, ident));
+
+    const double zero[9] = {0};
+    CHECK(fs_eigen_sym3(zero, l, v) == 0);
+    CHECK(l[0] == 0 && l[1] == 0 && l[2] == 0);
+    CHECK(same9(v, ident));
+
+    /* Two equal diagonal entries, one different: still exact, ties kept in axis order. */
+    const double two[9] = {-4, 0, 0, 0, 7, 0, 0, 0, -4};
+    CHECK(fs_eigen_sym3(two, l, v) == 0);
+    CHECK(l[0] == 7 && l[1] == -4 && l[2] == -4);
+    CHECK(v[1] == 1 && v[3] == 1 && v[8] == -1); /* e_y, e_x, e_y x e_x = -e_z */
+
+    /* Values only. */
+    CHECK(fs_eigen_sym3(diag, l, NULL) == 0);
+    CHECK(l[0] == 5 && l[1] == 2 && l[2] == -1);
+
+    /* Non-finite input is an error, not a hang. */
+    const double bad[9] = {1, NAN, 0, NAN, 1, 0, 0, 0, 1};
+    fs_error_clear();
+    CHECK(fs_eigen_sym3(bad, l, v) == -1);
+    CHECK(fs_error_domain() == FS_ERR_INTERNAL);
+    fs_error_clear();
+}
+
+static void test_principal_stress(void)
+{
+    /* Pure shear tau_xy: principal stresses +-tau on planes at 45 degrees. */
+    const double tau = 2.5;
+    const double shear[6] = {0, 0, 0, tau, 0, 0};
+    double s[3], d[9];
+    CHECK(fs_eigen_principal_stress(shear, s, d) == 0);
+    CHECK_NEAR(s[0], tau, 1e-15);
+    CHECK_NEAR(s[1], 0.0, 1e-15);
+    CHECK_NEAR(s[2], -tau, 1e-15);
+    CHECK_NEAR(d[0], sqrt(0.5), 1e-15);
+    CHECK_NEAR(d[1], sqrt(0.5), 1e-15);
+    CHECK_NEAR(fabs(d[6]), sqrt(0.5), 1e-15);
+    CHECK_NEAR(fabs(d[7]), sqrt(0.5), 1e-15);
+    CHECK_NEAR(d[6] * d[7], -0.5, 1e-15);
+    CHECK_NEAR(fabs(d[5]), 1.0, 1e-15);
+    /* The same for tau_yz and tau_zx: the Voigt order is xx, yy, zz, xy, yz, zx. */
+    const double shear_yz[6] = {0, 0, 0, 0, tau, 0}, shear_zx[6] = {0, 0, 0, 0, 0, tau};
+    CHECK(fs_eigen_principal_stress(shear_yz, s, d) == 0);
+    CHECK_NEAR(s[0], tau, 1e-15);
+    CHECK_NEAR(d[1] * d[2], 0.5, 1e-15);
+    CHECK(fs_eigen_principal_stress(shear_zx, s, d) == 0);
+    CHECK_NEAR(s[2], -tau, 1e-15);
+    CHECK_NEAR(d[6] * d[8], -0.5, 1e-15);
+    CHECK_NEAR(fs_eigen_von_mises(shear), sqrt(3.0) * tau, 1e-14);
+
+    /* Uniaxial stress along a tilted unit direction n: principal (sigma, 0, 0) with normal +-n, and
+     * von Mises |sigma|, for tension and compression. */
+    const double n[3] = {2.0 / 7.0, 3.0 / 7.0, 6.0 / 7.0};
+    for (int sign = -1; sign <= 1; sign += 2) {
+        double sigma = sign * 40.0;
+        const double st[6] = {sigma * n[0] * n[0], sigma * n[1] * n[1], sigma * n[2] * n[2],
+                              sigma * n[0] * n[1], sigma * n[1] * n[2], sigma * n[2] * n[0]};
+        CHECK_NEAR(fs_eigen_von_mises(st), fabs(sigma), 1e-12);
+        CHECK(fs_eigen_principal_stress(st, s, d) == 0);
+        const double *dir = sigma > 0 ? d : d + 6;
+        CHECK_NEAR(sigma > 0 ? s[0] : s[2], sigma, 1e-12);
+        CHECK_NEAR(sigma > 0 ? s[2] : s[0], 0.0, 1e-12);
+        CHECK_NEAR(fabs(dir[0] * n[0] + dir[1] * n[1] + dir[2] * n[2]), 1.0, 1e-14);
+    }
+    const double uni[6] = {-3, 0, 0, 0, 0, 0};
+    CHECK(fs_eigen_von_mises(uni) == 3.0);
+    /* A hydrostatic stress has no von Mises stress. */
+    const double hydro[6] = {5, 5, 5, 0, 0, 0};
+    CHECK(fs_eigen_von_mises(hydro) == 0.0);
+
+    /* Principal strains: an engineering shear gamma gives +-gamma/2. */
+    const double gamma[6] = {0, 0, 0, 0.002, 0, 0};
+    CHECK(fs_eigen_principal_strain(gamma, s, NULL) == 0);
+    CHECK_NEAR(s[0], 0.001, 1e-18);
+    CHECK_NEAR(s[2], -0.001, 1e-18);
+}
+
+/* ---- rank ---- */
+
+static void test_rank_largest(void)
+{
+    const double ratio[] = {0.3, 1.2, 0.9, 1.5, 1.1, -2.0};
+    CHECK(fs_rank_pick(ratio, NULL, 6, 1) == 3);
+    const uint64_t ids[] = {50, 40, 30, 20, 10, 0};
+    for (uint64_t seed = 0; seed < 20; seed++)
+        CHECK(fs_rank_pick(ratio, ids, 6, seed) == 3);
+    CHECK(fs_rank_count_over(ratio, 6) == 3);
+    /* Exactly 1 is not over the threshold. */
+    const double edge[] = {1.0, 1.0 + 1e-15, 0.999};
+    CHECK(fs_rank_count_over(edge, 3) == 1);
+    /* Close ratios that are not ties (relative gap 1e-9): the larger wins for every seed. */
+    const double close[] = {2.0, 2.0 * (1 + 1e-9)};
+    for (uint64_t seed = 0; seed < 50; seed++)
+        CHECK(fs_rank_pick(close, NULL, 2, seed) == 1);
+    /* Empty and NaN input. */
+    CHECK(fs_rank_pick(ratio, NULL, 0, 1) == -1);
+    CHECK(fs_rank_count_over(ratio, 0) == 0);
+    const double nans[] = {NAN, NAN};
+    CHECK(fs_rank_pick(nans, NULL, 2, 1) == -1);
+    const double some_nan[] = {NAN, 0.5, NAN, 0.2};
+    CHECK(fs_rank_pick(some_nan, NULL, 4, 1) == 1);
+    CHECK(fs_rank_count_over(some_nan, 4) == 0);
+}
+
+/* Candidates for the tie tests: four tie at 2 (one 1e-13 relative above), two are lower. */
+static const double tie_ratio[6] = {2.0, 1.9, 2.0 * (1 + 1e-13), 2.0, 0.5, 2.0};
+static const uint64_t tie_id[6] = {101, 7, 33, 58, 12, 999};
+
+static int next_permutation(int *p, int n)
+{
+    int i = n - 2;
+    while (i >= 0 && p[i] >= p[i + 1])
+        i--;
+    if (i < 0)
+        return 0;
+    int j = n - 1;
+    while (p[j] <= p[i])
+        j--;
+    int t = p[i];
+    p[i] = p[j];
+    p[j] = t;
+    for (int a = i + 1, b = n - 1; a < b; a++, b--) {
+        t = p[a];
+        p[a] = p[b];
+        p[b] = t;
+    }
+    return 1;
+}
+
+/* The id chosen among the tied candidates for the given seed, for every order of the input; -1 if
+ * two orders disagree. */
+static int64_t tie_winner(uint64_t seed)
+{
+    int perm[6] = {0, 1, 2, 3, 4, 5};
+    int64_t winner = -2;
+    do {
+        double r[6];
+        uint64_t id[6];
+        for (int k = 0; k < 6; k++) {
+            r[k] = tie_ratio[perm[k]];
+            id[k] = tie_id[perm[k]];
+        }
+        int32_t pick = fs_rank_pick(r, id, 6, seed);
+        if (pick < 0)
+            return -1;
+        if (winner == -2)
+            winner = (int64_t)id[pick];
+        else if (winner != (int64_t)id[pick])
+            return -1;
+    } while (next_permutation(perm, 6));
+    return winner;
+}
+
+static void test_rank_ties(void)
+{
+    /* All 720 orders agree, and the winner is the tied candidate with the smallest hash. */
+    for (uint64_t seed = 0; seed < 8; seed++) {
+        int64_t w = tie_winner(seed);
+        CHECK_MSG(w >= 0, "seed %llu: orders disagree", (unsigned long long)seed);
+        uint64_t best = 0;
+        int64_t expect = -1;
+        for (int k = 0; k < 6; k++) {
+            if (tie_ratio[k] < 2.0)
+                continue;
+            uint64_t h = fs_hash3(seed, FS_RNG_TIEBREAK, tie_id[k]);
+            if (expect < 0 || h < best) {
+                best = h;
+                expect = (int64_t)tie_id[k];
+            }
+        }
+        CHECK(w == expect);
+    }
+    /* Different seeds break the tie differently: over 64 seeds, at least three of the four tied
+     * candidates win sometimes, and the lower ones never do. */
+    int wins[6] = {0};
+    for (uint64_t seed = 0; seed < 64; seed++) {
+        int32_t pick = fs_rank_pick(tie_ratio, tie_id, 6, seed);
+        CHECK(pick >= 0);
+        if (pick >= 0)
+            wins[pick]++;
+    }
+    CHECK(wins[1] == 0 && wins[4] == 0);
+    CHECK((wins[0] > 0) + (wins[2] > 0) + (wins[3] > 0) + (wins[5] > 0) >= 3);
+}
+
+/* ---- event ---- */
+
+typedef struct {
+    int kind;       /* which ratio function */
+    double t_star;  /* first crossing of ratio 1 */
+    int calls;
+    double last_t;
+    int fail_after; /* > 0: return NaN from this call on */
+} ratio_ctx;
+
+static double ratio_at(int kind, double t_star, double t)
+{
+    switch (kind) {
+    case 0: return (t / t_star) * (t / t_star);                        /* thesis-like growth: stress ~ t^2 */
+    case 1: return 0.8 + 0.2 * pow((t - 2.0) / (t_star - 2.0), 3.0);   /* starts at 0.8 at t = 2 */
+    default: return 0.5 + 0.7 * sin(t);                                /* crosses at asin(5/7), falls back later */
+    }
+}
+
+static double ratio_fn(void *ctx, double t)
+{
+    ratio_ctx *c = ctx;
+    c->calls++;
+    c->last_t = t;
+    if (c->fail_after > 0 && c->calls >= c->fail_after) {
+        fs_error(FS_ERR_INTERNAL, "test: equilibrium failed");
+        return NAN;
+    }
+    return ratio_at(c->kind, c->t_star, t);
+}
+
+static void test_event_quadratic(void)
+{
+    ratio_ctx c = {0, 0.7, 0, 0, 0};
+    fs_event_result r;
+    CHECK(fs_event_find(ratio_fn, &c, 0.0, 0.01, 10.0, 1e-6, &r) == 0);
+    CHECK(r.found == 1);
+    CHECK(r.t >= 0.7);
+    CHECK(r.t - 0.7 < 1e-6);
+    CHECK(r.t_before <= 0.7);
+    CHECK(r.t - r.t_before < 1e-6);
+    CHECK(r.ratio > 1.0);
+    CHECK(r.ratio == ratio_at(0, 0.7, r.t));
+    CHECK(r.evaluations == c.calls);
+    CHECK(r.t_last == c.last_t);
+    /* Logarithmic cost: 7 doubling steps to pass 0.7 from 0.01, then log2(0.64 / 1e-6) bisections. */
+    double bound = 2.0 + log2(0.7 / 0.01 + 1.0) + 1.0 + log2(0.7 / 1e-6) + 1.0;
+    CHECK_MSG(r.evaluations <= bound, "%d evaluations", r.evaluations);
+}
+
+static void test_event_none(void)
+{
+    ratio_ctx c = {0, 0.7, 0, 0, 0};
+    fs_event_result r;
+    CHECK(fs_event_find(ratio_fn, &c, 0.0, 0.01, 0.5, 1e-6, &r) == 0);
+    CHECK(r.found == 0);
+    CHECK(r.t == 0.5);
+    CHECK(r.t_last == 0.5);
+    CHECK(r.ratio == ratio_at(0, 0.7, 0.5));
+    CHECK(r.evaluations == c.calls && r.evaluations <= 7); /* 0.01, 0.03, 0.07, 0.15, 0.31, 0.5 */
+    /* An empty interval calls nothing. */
+    c.calls = 0;
+    CHECK(fs_event_find(ratio_fn, &c, 0.5, 0.01, 0.5, 1e-6, &r) == 0);
+    CHECK(r.found == 0 && r.evaluations == 0 && c.calls == 0 && isnan(r.ratio));
+    /* The crossing exactly at t_end: f(t_end) = 1 is not over the threshold. */
+    c.calls = 0;
+    CHECK(fs_event_find(ratio_fn, &c, 0.0, 0.01, 0.7, 1e-6, &r) == 0);
+    CHECK(r.found == 0);
+}
+
+static void test_event_logarithmic(void)
+{
+    /* Each factor 2 of resolution costs one more evaluation: 1e-4 -> 1e-8 adds about log2(1e4) = 13.3. */
+    int evals[2];
+    const double steps[2] = {1e-4, 1e-8};
+    for (int k = 0; k < 2; k++) {
+        ratio_ctx c = {0, 0.7, 0, 0, 0};
+        fs_event_result r;
+        CHECK(fs_event_find(ratio_fn, &c, 0.0, 0.01, 10.0, steps[k], &r) == 0);
+        CHECK(r.found && r.t >= 0.7 && r.t - 0.7 < steps[k]);
+        evals[k] = r.evaluations;
+    }
+    CHECK_MSG(evals[1] - evals[0] >= 12 && evals[1] - evals[0] <= 15, "%d then %d", evals[0], evals[1]);
+    /* A tiny trial step is grown, not walked: from 1e-9 to 0.7 takes about log2(0.7e9) = 29 steps, and
+     * the bisection of the last step (up to 0.7 wide) about as many again, not 0.7e9 calls. */
+    ratio_ctx c = {0, 0.7, 0, 0, 0};
+    fs_event_result r;
+    CHECK(fs_event_find(ratio_fn, &c, 0.0, 1e-9, 10.0, 1e-9, &r) == 0);
+    CHECK(r.found && r.t >= 0.7 && r.t - 0.7 < 1e-9);
+    double bound = log2(0.7 / 1e-9 + 1.0) + 1.0 + log2(0.7 / 1e-9) + 2.0;
+    CHECK_MSG(r.evaluations <= bound, "%d evaluations", r.evaluations);
+}
+
+/* "The adaptive time step finds the first fracture time within time.min_step of a brute-force scan." */
+static void test_event_brute_force(void)
+{
+    static const struct { int kind; double t_star, t0, dt; } cases[] = {
+        {0, 0.7, 0.0, 0.01}, {0, 0.7, 0.3, 0.2}, {0, 0.7, 0.699, 1.0}, {0, 3.3, 1.0, 0.05},
+        {1, 2.45, 2.0, 0.01}, {1, 5.0, 2.0, 0.3}, {2, 0.0, 0.0, 0.05}, {2, 0.0, 0.5, 0.001},
+    };
+    const double min_step = 1e-4, t_end = 20.0;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        double brute = -1.0;
+        for (long i = 1; cases[k].t0 + (double)i * min_step <= t_end; i++) {
+            double t = cases[k].t0 + (double)i * min_step;
+            if (ratio_at(cases[k].kind, cases[k].t_star, t) > 1.0) {
+                brute = t;
+                break;
+            }
+        }
+        ratio_ctx c = {cases[k].kind, cases[k].t_star, 0, 0, 0};
+        fs_event_result r;
+        CHECK(fs_event_find(ratio_fn, &c, cases[k].t0, cases[k].dt, t_end, min_step, &r) == 0);
+        CHECK_MSG(r.found && brute > 0 && fabs(r.t - brute) <= min_step,
+                  "case %zu: adaptive %.9g, brute force %.9g", k, r.t, brute);
+        CHECK(r.evaluations < 40);
+    }
+}
+
+static void test_event_errors(void)
+{
+    ratio_ctx c = {0, 0.7, 0, 0, 0};
+    fs_event_result r;
+    fs_error_clear();
+    CHECK(fs_event_find(ratio_fn, &c, 1.0, 0.1, 0.5, 1e-3, &r) == -1);
+    CHECK(fs_error_domain() == FS_ERR_DATA);
+    fs_error_clear();
+    CHECK(fs_event_find(ratio_fn, &c, 0.0, 0.1, 1.0, 0.0, &r) == -1);
+    CHECK(fs_event_find(ratio_fn, &c, 0.0, -1.0, 1.0, 1e-3, &r) == -1);
+    CHECK(fs_event_find(ratio_fn, &c, 0.0, 0.1, NAN, 1e-3, &r) == -1);
+    CHECK(c.calls == 0);
+    fs_error_clear();
+    /* A failing callback stops the search and its message is kept. */
+    ratio_ctx bad = {0, 0.7, 0, 0, 9};
+    CHECK(fs_event_find(ratio_fn, &bad, 0.0, 0.01, 10.0, 1e-6, &r) == -1);
+    CHECK(bad.calls == 9 && r.evaluations == 9);
+    CHECK(strcmp(fs_error_message(), "test: equilibrium failed") == 0);
+    fs_error_clear();
+}
+
+int main(void)
+{
+    RUN(test_eigen_random);
+    RUN(test_eigen_prescribed);
+    RUN(test_eigen_exact_cases);
+    RUN(test_principal_stress);
+    RUN(test_rank_largest);
+    RUN(test_rank_ties);
+    RUN(test_event_quadratic);
+    RUN(test_event_none);
+    RUN(test_event_logarithmic);
+    RUN(test_event_brute_force);
+    RUN(test_event_errors);
+    return check_finish();
+}

@@ -1,0 +1,633 @@
+/* Tests of the sparse solvers: assembly, products, CHOLMOD Cholesky (factor, refactor, update) and CG. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "base/error.h"
+#include "base/rng.h"
+#include "check.h"
+#include "solve/cg.h"
+#include "solve/sparse.h"
+
+static const double pi = 3.14159265358979323846;
+
+static double norm2(int32_t n, const double *v)
+{
+    double s = 0.0;
+    for (int32_t i = 0; i < n; i++)
+        s += v[i] * v[i];
+    return sqrt(s);
+}
+
+/* ||a - b|| / ||b||. */
+static double relative_difference(int32_t n, const double *a, const double *b)
+{
+    double d = 0.0;
+    for (int32_t i = 0; i < n; i++)
+        d += (a[i] - b[i]) * (a[i] - b[i]);
+    return sqrt(d) / norm2(n, b);
+}
+
+/* ||b - A x|| / ||b||. */
+static double relative_residual(const fs_sparse_matrix *a, const double *x, const double *b)
+{
+    double *ax = malloc((size_t)a->n * sizeof *ax);
+    fs_sparse_matvec(a, x, ax);
+    double r = relative_difference(a->n, ax, b);
+    free(ax);
+    return r;
+}
+
+static double *random_vector(int32_t n, uint64_t seed)
+{
+    double *v = malloc((size_t)n * sizeof *v);
+    for (int32_t i = 0; i < n; i++)
+        v[i] = fs_rand_range(seed, FS_RNG_TEST, (uint64_t)i, -1.0, 1.0);
+    return v;
+}
+
+/* The 5-point Laplacian on an m×m grid of interior points with zero Dirichlet boundary: eigenvalues
+ * 4 sin²(iπ/(2(m+1))) + 4 sin²(jπ/(2(m+1))). */
+static void assemble_poisson(int32_t m, fs_sparse_matrix *a)
+{
+    fs_sparse_builder b;
+    fs_sparse_builder_init(&b, m * m, 0);
+    for (int32_t y = 0; y < m; y++) {
+        for (int32_t x = 0; x < m; x++) {
+            int32_t i = y * m + x;
+            fs_sparse_builder_add(&b, i, i, 4.0);
+            if (x + 1 < m)
+                fs_sparse_builder_add(&b, i, i + 1, -1.0);
+            if (y + 1 < m)
+                fs_sparse_builder_add(&b, i + m, i, -1.0);
+        }
+    }
+    CHECK(fs_sparse_builder_compress(&b, a, NULL) == 0);
+    fs_sparse_builder_free(&b);
+}
+
+static double poisson_condition(int32_t m)
+{
+    double lo = sin(pi / (2.0 * (m + 1)));
+    double hi = sin(m * pi / (2.0 * (m + 1)));
+    return hi * hi / (lo * lo);
+}
+
+/* A plane-stress strip of linear (constant-strain) triangles: nx×ny cells of size h, two triangles each,
+ * 2 unknowns per node, the bottom row of nodes fixed. Element e has Young's modulus
+ * E (1 + variation u_e), u_e uniform in [0, 1) from seed. */
+typedef struct {
+    int32_t nx, ny;
+    int32_t n;        /* unknowns */
+    int32_t *dof;     /* per node: first unknown, or -1 if fixed */
+} strip;
+
+static strip strip_make(int32_t nx, int32_t ny)
+{
+    strip s;
+    s.nx = nx;
+    s.ny = ny;
+    s.dof = malloc((size_t)(nx + 1) * (size_t)(ny + 1) * sizeof *s.dof);
+    s.n = 0;
+    for (int32_t y = 0; y <= ny; y++) {
+        for (int32_t x = 0; x <= nx; x++) {
+            s.dof[y * (nx + 1) + x] = y == 0 ? -1 : s.n;
+            if (y > 0)
+                s.n += 2;
+        }
+    }
+    return s;
+}
+
+static int32_t strip_elements(const strip *s) { return 2 * s->nx * s->ny; }
+
+/* Global indices (6) and stiffness (6×6, row-major) of element e. */
+static void strip_element(const strip *s, int32_t e, double variation, uint64_t seed, int32_t idx[6], double ke[36])
+{
+    const double young = 1000.0, poisson = 0.3, h = 0.5, thickness = 0.1;
+    int32_t cell = e / 2, cx = cell % s->nx, cy = cell / s->nx;
+    int32_t n00 = cy * (s->nx + 1) + cx, n10 = n00 + 1, n01 = n00 + s->nx + 1, n11 = n01 + 1;
+    int32_t nodes[3];
+    if (e % 2 == 0) {
+        nodes[0] = n00;
+        nodes[1] = n10;
+        nodes[2] = n11;
+    } else {
+        nodes[0] = n00;
+        nodes[1] = n11;
+        nodes[2] = n01;
+    }
+    double px[3], py[3];
+    for (int a = 0; a < 3; a++) {
+        int32_t node = nodes[a];
+        px[a] = h * (node % (s->nx + 1));
+        py[a] = h * (node / (s->nx + 1));
+        int32_t d = s->dof[node];
+        idx[2 * a] = d < 0 ? -1 : d;
+        idx[2 * a + 1] = d < 0 ? -1 : d + 1;
+    }
+    double area2 = (px[1] - px[0]) * (py[2] - py[0]) - (px[2] - px[0]) * (py[1] - py[0]);
+    double dn_dx[3] = {(py[1] - py[2]) / area2, (py[2] - py[0]) / area2, (py[0] - py[1]) / area2};
+    double dn_dy[3] = {(px[2] - px[1]) / area2, (px[0] - px[2]) / area2, (px[1] - px[0]) / area2};
+    double bm[3][6] = {{0}};
+    for (int a = 0; a < 3; a++) {
+        bm[0][2 * a] = dn_dx[a];
+        bm[1][2 * a + 1] = dn_dy[a];
+        bm[2][2 * a] = dn_dy[a];
+        bm[2][2 * a + 1] = dn_dx[a];
+    }
+    double ee = young * (1.0 + variation * fs_rand01(seed, FS_RNG_TEST, (uint64_t)e));
+    double f = ee / (1.0 - poisson * poisson);
+    double d[3][3] = {{f, f * poisson, 0.0}, {f * poisson, f, 0.0}, {0.0, 0.0, f * (1.0 - poisson) / 2.0}};
+    double volume = 0.5 * area2 * thickness;
+    for (int i = 0; i < 6; i++) {
+        for (int j = 0; j < 6; j++) {
+            double sum = 0.0;
+            for (int k = 0; k < 3; k++)
+                for (int l = 0; l < 3; l++)
+                    sum += bm[k][i] * d[k][l] * bm[l][j];
+            ke[i * 6 + j] = volume * sum;
+        }
+    }
+}
+
+/* Assembles the strip; if first is not NULL it receives each element's first entry number. */
+static void strip_assemble(const strip *s, double variation, uint64_t seed, fs_sparse_matrix *a, int32_t **slots,
+                           size_t *first)
+{
+    fs_sparse_builder b;
+    fs_sparse_builder_init(&b, s->n, (size_t)strip_elements(s) * 21);
+    for (int32_t e = 0; e < strip_elements(s); e++) {
+        int32_t idx[6];
+        double ke[36];
+        strip_element(s, e, variation, seed, idx, ke);
+        if (first)
+            first[e] = b.count;
+        fs_sparse_builder_add_block(&b, 6, idx, ke);
+    }
+    if (slots)
+        *slots = malloc(b.count * sizeof **slots);
+    CHECK(fs_sparse_builder_compress(&b, a, slots ? *slots : NULL) == 0);
+    fs_sparse_builder_free(&b);
+}
+
+static void test_builder_sums_duplicates(void)
+{
+    fs_sparse_builder b;
+    fs_sparse_builder_init(&b, 4, 2);
+    fs_sparse_builder_add(&b, 0, 0, 1.0);
+    fs_sparse_builder_add(&b, 1, 0, 2.0);
+    fs_sparse_builder_add(&b, 0, 1, 3.0);
+    fs_sparse_builder_add(&b, 2, 2, 5.0);
+    fs_sparse_builder_add(&b, 3, 1, -1.0);
+    fs_sparse_builder_add(&b, 2, 2, 0.5);
+    CHECK(fs_sparse_builder_add(&b, 1, 3, 4.0) == 6);
+    int32_t slots[7];
+    fs_sparse_matrix m;
+    CHECK(fs_sparse_builder_compress(&b, &m, slots) == 0);
+
+    const int32_t col_ptr[] = {0, 1, 3, 4, 6};
+    const int32_t row_idx[] = {0, 0, 1, 2, 1, 3};
+    const double values[] = {1.0, 5.0, 0.0, 5.5, 3.0, 0.0};
+    const int32_t expected_slots[] = {0, 1, 1, 3, 4, 3, 4};
+    CHECK(m.n == 4 && fs_sparse_matrix_nnz(&m) == 6);
+    for (int j = 0; j <= 4; j++)
+        CHECK(m.col_ptr[j] == col_ptr[j]);
+    for (int p = 0; p < 6; p++) {
+        CHECK(m.row_idx[p] == row_idx[p]);
+        CHECK(m.values[p] == values[p]);
+    }
+    for (int e = 0; e < 7; e++)
+        CHECK(slots[e] == expected_slots[e]);
+    fs_sparse_matrix_free(&m);
+    fs_sparse_builder_free(&b);
+}
+
+static void test_matvec_matches_dense(void)
+{
+    enum { n = 7 };
+    double dense[n][n];
+    fs_sparse_builder b;
+    fs_sparse_builder_init(&b, n, 0);
+    for (int i = 0; i < n; i++) {
+        for (int j = i; j < n; j++) {
+            double u = fs_rand01(11, FS_RNG_TEST, (uint64_t)(i * n + j));
+            double v = u < 0.4 ? 0.0 : 2.0 * u - 1.0;
+            dense[i][j] = dense[j][i] = v;
+            if (v != 0.0)
+                fs_sparse_builder_add(&b, j, i, v);
+        }
+    }
+    fs_sparse_matrix m;
+    CHECK(fs_sparse_builder_compress(&b, &m, NULL) == 0);
+    double *x = random_vector(n, 12);
+    double y[n];
+    fs_sparse_matvec(&m, x, y);
+    for (int i = 0; i < n; i++) {
+        double s = 0.0;
+        for (int j = 0; j < n; j++)
+            s += dense[i][j] * x[j];
+        CHECK_NEAR(y[i], s, 1e-14);
+    }
+    free(x);
+    fs_sparse_matrix_free(&m);
+    fs_sparse_builder_free(&b);
+}
+
+/* Rewriting the values through the slots after a material change reproduces a fresh assembly exactly. */
+static void test_slots_reproduce_fresh_assembly(void)
+{
+    strip s = strip_make(12, 9);
+    int32_t ne = strip_elements(&s);
+    size_t *first = malloc((size_t)ne * sizeof *first);
+    int32_t *slots;
+    fs_sparse_matrix a, fresh;
+    strip_assemble(&s, 0.5, 1, &a, &slots, first);
+    strip_assemble(&s, 0.8, 2, &fresh, NULL, NULL);
+
+    fs_sparse_matrix_zero(&a);
+    for (int32_t e = 0; e < ne; e++) {
+        int32_t idx[6];
+        double ke[36];
+        strip_element(&s, e, 0.8, 2, idx, ke);
+        fs_sparse_matrix_add_block(&a, 6, idx, ke, slots + first[e]);
+    }
+    CHECK(a.n == fresh.n && fs_sparse_matrix_nnz(&a) == fs_sparse_matrix_nnz(&fresh));
+    int same = 1;
+    for (int32_t j = 0; j <= a.n; j++)
+        same &= a.col_ptr[j] == fresh.col_ptr[j];
+    for (int32_t p = 0; p < fs_sparse_matrix_nnz(&a); p++)
+        same &= a.row_idx[p] == fresh.row_idx[p] && a.values[p] == fresh.values[p];
+    CHECK_MSG(same, "slot update differs from a fresh assembly");
+    free(first);
+    free(slots);
+    free(s.dof);
+    fs_sparse_matrix_free(&a);
+    fs_sparse_matrix_free(&fresh);
+}
+
+static void test_cholesky_solves_poisson(void)
+{
+    enum { m = 50, n = m * m, nrhs = 3 };
+    fs_sparse_matrix a;
+    assemble_poisson(m, &a);
+    double *b = random_vector(n * nrhs, 3);
+    double *x = malloc((size_t)n * nrhs * sizeof *x);
+    double *x1 = malloc((size_t)n * sizeof *x1);
+    fs_cholesky *c = fs_cholesky_analyze(&a);
+    CHECK(c != NULL);
+    CHECK(fs_cholesky_factorize(c, &a) == 0);
+    CHECK(fs_cholesky_solve(c, 1, b, x1) == 0);
+    CHECK_MSG(relative_residual(&a, x1, b) <= 1e-10, "residual %g", relative_residual(&a, x1, b));
+    CHECK(fs_cholesky_solve(c, nrhs, b, x) == 0);
+    for (int r = 0; r < nrhs; r++)
+        CHECK_MSG(relative_residual(&a, x + r * n, b + r * n) <= 1e-10, "rhs %d", r);
+    CHECK(relative_difference(n, x, x1) <= 1e-13);
+    fs_cholesky_info info = fs_cholesky_get_info(c);
+    CHECK(info.n == n && info.factor_nonzeros >= fs_sparse_matrix_nnz(&a) && info.flops > 0.0);
+    fs_cholesky_free(c);
+    free(b);
+    free(x);
+    free(x1);
+    fs_sparse_matrix_free(&a);
+}
+
+static void test_cholesky_solves_elasticity(void)
+{
+    strip s = strip_make(60, 60);
+    fs_sparse_matrix a;
+    strip_assemble(&s, 0.5, 4, &a, NULL, NULL);
+    double *b = random_vector(s.n, 5);
+    double *x = malloc((size_t)s.n * sizeof *x);
+    fs_cholesky *c = fs_cholesky_analyze(&a);
+    CHECK(c != NULL);
+    fs_cholesky_info info = fs_cholesky_get_info(c);
+    CHECK_MSG(info.supernodal == 1, "a 2-D elasticity matrix of %d unknowns should get a supernodal factor", s.n);
+    CHECK(fs_cholesky_factorize(c, &a) == 0);
+    CHECK(fs_cholesky_solve(c, 1, b, x) == 0);
+    CHECK_MSG(relative_residual(&a, x, b) <= 1e-10, "residual %g", relative_residual(&a, x, b));
+    fs_cholesky_free(c);
+    free(b);
+    free(x);
+    free(s.dof);
+    fs_sparse_matrix_free(&a);
+}
+
+/* Refactorizing after scaling every value by s gives the solution divided by s. */
+static void test_refactorize_scaled_values(void)
+{
+    const double scale = 3.5;
+    strip s = strip_make(40, 30);
+    fs_sparse_matrix a;
+    strip_assemble(&s, 0.5, 6, &a, NULL, NULL);
+    double *b = random_vector(s.n, 7);
+    double *x1 = malloc((size_t)s.n * sizeof *x1);
+    double *x2 = malloc((size_t)s.n * sizeof *x2);
+    fs_cholesky *c = fs_cholesky_analyze(&a);
+    CHECK(fs_cholesky_factorize(c, &a) == 0);
+    CHECK(fs_cholesky_solve(c, 1, b, x1) == 0);
+    for (int32_t p = 0; p < fs_sparse_matrix_nnz(&a); p++)
+        a.values[p] *= scale;
+    CHECK(fs_cholesky_factorize(c, &a) == 0);
+    CHECK(fs_cholesky_solve(c, 1, b, x2) == 0);
+    for (int32_t i = 0; i < s.n; i++)
+        x2[i] *= scale;
+    CHECK(relative_difference(s.n, x2, x1) <= 1e-12);
+    fs_cholesky_free(c);
+    free(b);
+    free(x1);
+    free(x2);
+    free(s.dof);
+    fs_sparse_matrix_free(&a);
+}
+
+/* Adds W W' (W given by columns in CSC) into a builder: each unordered pair once. */
+static void add_outer(fs_sparse_builder *b, int32_t rank, const int32_t *col_ptr, const int32_t *rows,
+                      const double *w)
+{
+    for (int32_t j = 0; j < rank; j++)
+        for (int32_t p = col_ptr[j]; p < col_ptr[j + 1]; p++)
+            for (int32_t q = p; q < col_ptr[j + 1]; q++)
+                fs_sparse_builder_add(b, rows[p], rows[q], w[p] * w[q]);
+}
+
+/* A rank-2 update W W' matches a fresh factorization of A + W W'; the downdate brings back the solution of
+ * A; refactorizing A after an update discards it and starts again from the analysis. */
+static void test_updown_matches_fresh_factorization(void)
+{
+    strip s = strip_make(40, 30);
+    int32_t ne = strip_elements(&s);
+    fs_sparse_builder b;
+    fs_sparse_builder_init(&b, s.n, 0);
+    for (int32_t e = 0; e < ne; e++) {
+        int32_t idx[6];
+        double ke[36];
+        strip_element(&s, e, 0.5, 8, idx, ke);
+        fs_sparse_builder_add_block(&b, 6, idx, ke);
+    }
+    fs_sparse_matrix a, a_plus;
+    CHECK(fs_sparse_builder_compress(&b, &a, NULL) == 0);
+
+    /* Two spring-like columns: sqrt(k) (e_i - e_j) on an x and a y unknown of neighbouring nodes, and a
+     * column touching rows far apart. */
+    const int32_t col_ptr[] = {0, 2, 5};
+    int32_t rows[] = {100, 102, s.n - 1, 7, s.n / 2};
+    double w[] = {30.0, -30.0, 12.0, -5.0, 8.0};
+    add_outer(&b, 2, col_ptr, rows, w);
+    CHECK(fs_sparse_builder_compress(&b, &a_plus, NULL) == 0);
+
+    double *rhs = random_vector(s.n, 9);
+    double *x = malloc((size_t)s.n * sizeof *x);
+    double *x_orig = malloc((size_t)s.n * sizeof *x_orig);
+    double *x_fresh = malloc((size_t)s.n * sizeof *x_fresh);
+
+    fs_cholesky *fresh = fs_cholesky_analyze(&a_plus);
+    CHECK(fs_cholesky_factorize(fresh, &a_plus) == 0);
+    CHECK(fs_cholesky_solve(fresh, 1, rhs, x_fresh) == 0);
+
+    fs_cholesky *c = fs_cholesky_analyze(&a);
+    int supernodal = fs_cholesky_get_info(c).supernodal;
+    CHECK_MSG(supernodal == 1, "the update should start from a supernodal factor (converted to LDL' by CHOLMOD)");
+    CHECK(fs_cholesky_factorize(c, &a) == 0);
+    CHECK(fs_cholesky_solve(c, 1, rhs, x_orig) == 0);
+    CHECK(fs_cholesky_updown(c, +1, 2, col_ptr, rows, w) == 0);
+    CHECK(fs_cholesky_solve(c, 1, rhs, x) == 0);
+    CHECK_MSG(relative_difference(s.n, x, x_fresh) <= 1e-10, "update: %g", relative_difference(s.n, x, x_fresh));
+    CHECK(relative_residual(&a_plus, x, rhs) <= 1e-10);
+    CHECK(fs_cholesky_updown(c, -1, 2, col_ptr, rows, w) == 0);
+    CHECK(fs_cholesky_solve(c, 1, rhs, x) == 0);
+    CHECK_MSG(relative_difference(s.n, x, x_orig) <= 1e-10, "downdate: %g", relative_difference(s.n, x, x_orig));
+
+    CHECK(fs_cholesky_updown(c, +1, 2, col_ptr, rows, w) == 0);
+    CHECK(fs_cholesky_factorize(c, &a) == 0);
+    CHECK(fs_cholesky_get_info(c).supernodal == supernodal);
+    CHECK(fs_cholesky_solve(c, 1, rhs, x) == 0);
+    CHECK(relative_difference(s.n, x, x_orig) <= 1e-12);
+
+    fs_cholesky_free(c);
+    fs_cholesky_free(fresh);
+    free(rhs);
+    free(x);
+    free(x_orig);
+    free(x_fresh);
+    free(s.dof);
+    fs_sparse_builder_free(&b);
+    fs_sparse_matrix_free(&a);
+    fs_sparse_matrix_free(&a_plus);
+}
+
+/* Output capture, to assert that a failing call prints nothing. */
+typedef struct {
+    FILE *file;
+    int saved_out, saved_err;
+} capture;
+
+static capture capture_begin(void)
+{
+    capture cap;
+    fflush(stdout);
+    fflush(stderr);
+    cap.file = tmpfile();
+    cap.saved_out = dup(1);
+    cap.saved_err = dup(2);
+    dup2(fileno(cap.file), 1);
+    dup2(fileno(cap.file), 2);
+    return cap;
+}
+
+static long capture_end(capture cap)
+{
+    fflush(stdout);
+    fflush(stderr);
+    dup2(cap.saved_out, 1);
+    dup2(cap.saved_err, 2);
+    close(cap.saved_out);
+    close(cap.saved_err);
+    fseek(cap.file, 0, SEEK_END);
+    long size = ftell(cap.file);
+    fclose(cap.file);
+    return size;
+}
+
+static int starts_with(const char *s, const char *prefix) { return strncmp(s, prefix, strlen(prefix)) == 0; }
+
+/* An indefinite matrix gives -1 and FS_ERR_INTERNAL naming the failing column, prints nothing, blocks
+ * solves, and a later positive definite matrix with the same pattern factorizes again. */
+static void test_indefinite_matrix_fails_cleanly(void)
+{
+    enum { n = 20, bad = 7 };
+    fs_sparse_builder b;
+    fs_sparse_builder_init(&b, n, 0);
+    for (int32_t i = 0; i < n; i++)
+        fs_sparse_builder_add(&b, i, i, i == bad ? -1.0 : 2.0 + i);
+    fs_sparse_matrix d;
+    CHECK(fs_sparse_builder_compress(&b, &d, NULL) == 0);
+    fs_sparse_builder_free(&b);
+    fs_cholesky *c = fs_cholesky_analyze(&d);
+    fs_error_clear();
+    capture cap = capture_begin();
+    int status = fs_cholesky_factorize(c, &d);
+    long printed = capture_end(cap);
+    CHECK(status == -1);
+    CHECK(fs_error_domain() == FS_ERR_INTERNAL);
+    CHECK_MSG(strcmp(fs_error_message(), "cholmod: matrix not positive definite at column 7") == 0, "%s",
+              fs_error_message());
+    CHECK(printed == 0);
+    double rhs[n], x[n];
+    for (int i = 0; i < n; i++)
+        rhs[i] = 1.0;
+    CHECK(fs_cholesky_solve(c, 1, rhs, x) == -1);
+    d.values[bad] = 1.0;
+    CHECK(fs_cholesky_factorize(c, &d) == 0);
+    CHECK(fs_cholesky_solve(c, 1, rhs, x) == 0);
+    CHECK_NEAR(x[bad], 1.0, 1e-15);
+    CHECK_NEAR(x[3], 1.0 / 5.0, 1e-15);
+    fs_cholesky_free(c);
+    fs_sparse_matrix_free(&d);
+
+    /* Poisson shifted by -5 I has eigenvalues on both sides of 0 (its spectrum is inside (0, 8)). */
+    fs_sparse_matrix a;
+    assemble_poisson(30, &a);
+    for (int32_t j = 0; j < a.n; j++)
+        a.values[a.col_ptr[j + 1] - 1] -= 5.0;
+    c = fs_cholesky_analyze(&a);
+    fs_error_clear();
+    cap = capture_begin();
+    status = fs_cholesky_factorize(c, &a);
+    printed = capture_end(cap);
+    CHECK(status == -1 && fs_error_domain() == FS_ERR_INTERNAL);
+    CHECK_MSG(starts_with(fs_error_message(), "cholmod: matrix not positive definite at column "), "%s",
+              fs_error_message());
+    CHECK(printed == 0);
+    fs_cholesky_free(c);
+    fs_sparse_matrix_free(&a);
+
+    /* The same through the supernodal factorization: a negative diagonal entry in column k of an SPD
+     * matrix makes k the first non-positive pivot whatever the ordering (every pivot eliminated before it
+     * belongs to a positive definite principal submatrix). */
+    strip s = strip_make(60, 60);
+    const int32_t k = 1234;
+    strip_assemble(&s, 0.5, 14, &a, NULL, NULL);
+    a.values[a.col_ptr[k + 1] - 1] = -1.0;
+    c = fs_cholesky_analyze(&a);
+    CHECK(fs_cholesky_get_info(c).supernodal == 1);
+    fs_error_clear();
+    cap = capture_begin();
+    status = fs_cholesky_factorize(c, &a);
+    printed = capture_end(cap);
+    CHECK(status == -1 && fs_error_domain() == FS_ERR_INTERNAL);
+    CHECK_MSG(strcmp(fs_error_message(), "cholmod: matrix not positive definite at column 1234") == 0, "%s",
+              fs_error_message());
+    CHECK(printed == 0);
+    fs_cholesky_free(c);
+    fs_sparse_matrix_free(&a);
+    free(s.dof);
+}
+
+/* A downdate that removes more than the matrix holds fails without printing. */
+static void test_downdate_to_indefinite_fails(void)
+{
+    fs_sparse_matrix a;
+    assemble_poisson(20, &a);
+    fs_cholesky *c = fs_cholesky_analyze(&a);
+    CHECK(fs_cholesky_factorize(c, &a) == 0);
+    const int32_t col_ptr[] = {0, 1};
+    const int32_t rows[] = {150};
+    const double w[] = {3.0};
+    fs_error_clear();
+    capture cap = capture_begin();
+    int status = fs_cholesky_updown(c, -1, 1, col_ptr, rows, w);
+    long printed = capture_end(cap);
+    CHECK(status == -1 && fs_error_domain() == FS_ERR_INTERNAL);
+    CHECK_MSG(strcmp(fs_error_message(), "cholmod: matrix not positive definite at column 150 after downdate") == 0,
+              "%s", fs_error_message());
+    CHECK(printed == 0);
+    CHECK(fs_cholesky_factorize(c, &a) == 0);
+    fs_cholesky_free(c);
+    fs_sparse_matrix_free(&a);
+}
+
+/* CG reaches its tolerance on the true residual, and then differs from the Cholesky solution by at most
+ * cond(A) times that tolerance (Poisson's condition number is known in closed form). */
+static void test_cg_agrees_with_cholesky(void)
+{
+    enum { m = 30, n = m * m };
+    const double tolerance = 1e-10;
+    fs_sparse_matrix a;
+    assemble_poisson(m, &a);
+    double *b = random_vector(n, 10);
+    double *x_chol = malloc(n * sizeof *x_chol);
+    double *x = calloc(n, sizeof *x);
+    fs_cholesky *c = fs_cholesky_analyze(&a);
+    CHECK(fs_cholesky_factorize(c, &a) == 0);
+    CHECK(fs_cholesky_solve(c, 1, b, x_chol) == 0);
+
+    fs_cg_params params = fs_cg_params_default();
+    params.tolerance = tolerance;
+    double reported;
+    int iterations = fs_cg_solve(&a, b, x, params, &reported);
+    CHECK_MSG(iterations > 0 && iterations < n, "iterations %d", iterations);
+    double residual = relative_residual(&a, x, b);
+    CHECK_MSG(residual <= tolerance, "residual %g", residual);
+    CHECK_NEAR(reported, residual, 1e-14);
+    double kappa = poisson_condition(m);
+    CHECK_MSG(relative_difference(n, x, x_chol) <= kappa * tolerance, "error %g, bound %g",
+              relative_difference(n, x, x_chol), kappa * tolerance);
+
+    for (int32_t i = 0; i < n; i++)
+        x[i] = x_chol[i];
+    CHECK(fs_cg_solve(&a, b, x, params, NULL) == 0);
+    fs_cholesky_free(c);
+    free(b);
+    free(x);
+    free(x_chol);
+    fs_sparse_matrix_free(&a);
+}
+
+static void test_cg_reports_failures(void)
+{
+    enum { m = 30, n = m * m };
+    fs_sparse_matrix a;
+    assemble_poisson(m, &a);
+    double *b = random_vector(n, 13);
+    double *x = calloc(n, sizeof *x);
+    fs_cg_params params = fs_cg_params_default();
+    params.tolerance = 1e-10;
+    params.max_iterations = 2;
+    fs_error_clear();
+    double reported = 0.0;
+    CHECK(fs_cg_solve(&a, b, x, params, &reported) == -1);
+    CHECK(fs_error_domain() == FS_ERR_INTERNAL);
+    CHECK_MSG(starts_with(fs_error_message(), "cg: no convergence after 2 iterations (relative residual "), "%s",
+              fs_error_message());
+    CHECK(reported > params.tolerance);
+
+    for (int32_t i = 0; i < n; i++)
+        x[i] = 0.0;
+    a.values[a.col_ptr[5] - 1] = 0.0;
+    fs_error_clear();
+    CHECK(fs_cg_solve(&a, b, x, fs_cg_params_default(), NULL) == -1);
+    CHECK(fs_error_domain() == FS_ERR_INTERNAL);
+    CHECK_MSG(starts_with(fs_error_message(), "cg: diagonal entry 4 "), "%s", fs_error_message());
+    free(b);
+    free(x);
+    fs_sparse_matrix_free(&a);
+}
+
+int main(void)
+{
+    RUN(test_builder_sums_duplicates);
+    RUN(test_matvec_matches_dense);
+    RUN(test_slots_reproduce_fresh_assembly);
+    RUN(test_cholesky_solves_poisson);
+    RUN(test_cholesky_solves_elasticity);
+    RUN(test_refactorize_scaled_values);
+    RUN(test_updown_matches_fresh_factorization);
+    RUN(test_indefinite_matrix_fails_cleanly);
+    RUN(test_downdate_to_indefinite_fails);
+    RUN(test_cg_agrees_with_cholesky);
+    RUN(test_cg_reports_failures);
+    return check_finish();
+}
