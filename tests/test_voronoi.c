@@ -1,5 +1,4 @@
-/* Tests of the voronoi model: its cells tile the texture, cracks follow the Voronoi edges, periodic
- * output closes up across the seams, and the sphere's map covers the poles. */
+/* Tests of the voronoi model: cells tile the texture, cracks follow Voronoi edges, seams close up. */
 #include "model/voronoi.h"
 
 #include <math.h>
@@ -163,7 +162,7 @@ static void geodesic_mesh(fs_mesh *m, double radius, int f)
     }
     free(local);
     m->shift = fs_calloc(6 * (size_t)m->n_tris, sizeof *m->shift);
-    /* the icosahedron's faces as listed are clockwise seen from outside for some; orient all */
+    /* make every triangle counter-clockwise seen from outside */
     for (int32_t t = 0; t < m->n_tris; t++) {
         double a[3], b[3], c[3], ab[3], ac[3], n[3];
         fs_mesh_corner(m, t, 0, a);

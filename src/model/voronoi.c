@@ -1,5 +1,4 @@
-/* The voronoi model: noise-warped Voronoi cells of the mesh nodes with crack strips and bevelled
- * rims, emitted as a texture-space render mesh (SPEC §5 "voronoi"). */
+/* The voronoi model (SPEC §5): noise-warped Voronoi cells with cracks and bevels, as a render mesh. */
 #include "model/voronoi.h"
 
 #include <math.h>
@@ -15,20 +14,24 @@
  * frame (plane, cylinder) with the corner shifts; an open ring (a node on the convex hull of a
  * non-periodic plane) is closed by the two rays along the outward normals of its boundary edges and
  * a far point on their bisector, and the polygon is clipped to the domain rectangle along the axes
- * that do not wrap. Each Voronoi edge is cut into `subdivisions` pieces; every boundary point and
- * the site are then moved by a smooth warp field that depends on position only (periodic with the
- * domain; tangential on the sphere; its normal component fades out towards a non-wrapping border
- * so cells still end exactly on it), so the two cells of an edge produce the same polyline.
+ * that do not wrap. Each Voronoi edge is cut into `subdivisions` pieces, computed from the edge's
+ * lexicographically smaller end; then every boundary point and the site are moved by a smooth warp
+ * field of position only (periodic with the domain; tangential on the sphere; its normal component
+ * fades out towards a non-wrapping border so cells still end exactly on it). The Voronoi vertices
+ * move too, so the cracks bend smoothly through them, and the two cells of an edge produce the
+ * same polyline.
  *   A cell is a fan of triangles (site, p_k, p_k+1). In a fan triangle the distance to the
- * segment p_k p_k+1 is affine, t = d / h along both legs, so the iso-lines d = crack_width / 2 and
- * d = crack_width / 2 + bevel cut it into a crack band, a bevel band and the top. The cut points on
- * a leg are shared by the two fan triangles of that leg (each leg carries the cut points of both),
- * and each band is triangulated by zipping its two legs: the render mesh is conforming, so it has
- * no cracks of its own at any resolution. Border segments of a clipped cell carry no crack.
- *   Sphere: the bands are built on the chords in 3-D; each triangle is subdivided until the
- * equirectangular map is close to affine on it, its u values are unwrapped around its first vertex,
- * and a triangle containing a pole is split at the pole into three triangles whose images are
- * strips of meridian segments reaching the pole's row of the texture. */
+ * segment p_k p_k+1 is affine (0 on it, h at the site), so the iso-lines d = crack_width / 2 and
+ * d = crack_width / 2 + bevel cut it into a crack band, a bevel band and the top. Each leg (site,
+ * p_k) carries the cut points of both fan triangles beside it, and each band is triangulated by
+ * zipping its two legs, so the render mesh is conforming: it has no cracks of its own at any
+ * resolution. Border segments of a clipped cell continue the distance of the Voronoi segment next
+ * to them (zone_polyline).
+ *   Sphere: the bands are built on the chords in 3-D and refined edge by edge until the
+ * equirectangular map is close to affine on each piece (refine_sphere, still conforming); each
+ * triangle's u values are unwrapped around its first vertex, and a triangle containing a pole is
+ * split at the pole into three whose images are columns of meridian segments reaching the pole's
+ * row of the texture. */
 
 fs_voronoi_params fs_voronoi_params_default(void)
 {
