@@ -1,0 +1,78 @@
+/* The resolved configuration of one run: what a preset (plus overrides) becomes, section by section. */
+#ifndef FS_SIM_CONFIG_H
+#define FS_SIM_CONFIG_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "field/field.h"
+#include "geom/domain.h"
+#include "model/voronoi.h"
+#include "render/render.h"
+
+typedef enum { FS_MODEL_VORONOI = 0, FS_MODEL_SPRINGS, FS_MODEL_WEDGE, FS_MODEL_SHELL, FS_MODEL_TET } fs_model_type;
+typedef enum { FS_LATTICE_RANDOM = 0, FS_LATTICE_HEX } fs_lattice;
+typedef enum { FS_FRACTURE_SPLIT = 0, FS_FRACTURE_REMOVE } fs_fracture_method;
+
+typedef struct {
+    char name[64];          /* short name, used as the default output name */
+    char description[256];  /* one line shown by --list-presets */
+    fs_model_type model;
+    uint64_t seed;          /* random seed (the command line's --seed overrides it) */
+} fs_preset_info;
+
+typedef struct {
+    int32_t elements;       /* target number of elements (voronoi: cells; springs: masses) */
+    double min_size;        /* smallest element dynamic subdivision may make (cm) */
+    fs_lattice lattice;     /* random (particle repulsion) or hexagonal lattice */
+    int relax_iterations;   /* particle repulsion iterations */
+    double radius_jitter;   /* random perturbation of the repulsion radii (relative) */
+} fs_mesh_params;
+
+typedef struct {
+    fs_fracture_method method;
+    bool griffith;          /* stop cracks by the Griffith energy criterion */
+} fs_fracture_params;
+
+typedef struct {
+    double end;             /* simulated end time */
+    double min_step;        /* smallest time step of the event search */
+} fs_time_params;
+
+typedef enum { FS_SOLVER_CHOLMOD = 0, FS_SOLVER_CG } fs_solver_method;
+
+/* How the finite element models solve for equilibrium: sparse Cholesky (factored once, updated after
+ * fractures) or the thesis' conjugate gradients, kept as a baseline. */
+typedef struct {
+    fs_solver_method method;
+    double tolerance;       /* cg: relative residual ||b - Ax|| / ||b|| to stop at */
+    int32_t max_iterations; /* cg: iteration limit, 0 for the number of unknowns */
+} fs_solver_params;
+
+/* Wedge model settings that have no section of their own. */
+typedef struct {
+    double thickness_gradient; /* relative change of the thickness across the texture in u: the
+                                  thickness is scaled by 1 + gradient (u - 1/2) */
+} fs_wedge_params;
+
+typedef struct {
+    fs_preset_info preset;
+    fs_domain domain;
+    fs_mesh_params mesh;
+    fs_material material;
+    fs_growth growth;
+    fs_shrink shrink;
+    fs_fracture_params fracture;
+    fs_time_params time;
+    fs_render_params render;
+    fs_voronoi_params voronoi;
+    fs_solver_params solver;
+    fs_wedge_params wedge;
+} fs_config;
+
+/* Every section at its default: a 10 x 10 cm non-periodic plane, voronoi model, 1000 elements. */
+fs_config fs_config_default(void);
+
+const char *fs_model_name(fs_model_type m);
+
+#endif
