@@ -427,6 +427,30 @@ static void test_torus(void)
     }
 }
 
+/* A square grid on the plane: every cell is cocircular, any diagonal is Delaunay; the mesh is
+ * still a valid triangulation of the rectangle. */
+static void test_plane_square_grid(void)
+{
+    int gx = 15, gy = 11;
+    fs_points p = points_alloc(gx * gy);
+    for (int j = 0; j < gy; j++)
+        for (int i = 0; i < gx; i++) {
+            p.p[3 * (j * gx + i)] = i * 0.5;
+            p.p[3 * (j * gx + i) + 1] = j * 0.5;
+        }
+    fs_domain d = plane_domain(gx * 0.5, gy * 0.5, false, false);
+    fs_mesh m;
+    CHECK(fs_delaunay(&d, &p, &m) == 0);
+    CHECK(count_nonpositive(&m) == 0);
+    CHECK(euler(&m) == 1);
+    CHECK(m.n_tris == 2 * (gx - 1) * (gy - 1));
+    CHECK(fs_mesh_count_boundary_edges(&m) == 2 * (gx - 1) + 2 * (gy - 1));
+    CHECK(count_circle_violations(&m) == 0);
+    CHECK_NEAR(total_area(&m), (gx - 1) * 0.5 * (gy - 1) * 0.5, 1e-12);
+    fs_mesh_free(&m);
+    free(p.p);
+}
+
 /* A square grid is cocircular everywhere: the tie-breaking retry must still close the torus. */
 static void test_torus_square_grid(void)
 {
@@ -618,15 +642,27 @@ static fs_points clamped_points(int gx, int gy, double w, double h, bool wrap_x,
 }
 
 /* More than 65536 points are triangulated in blocks (in parallel): the merged mesh is still the
- * one Delaunay triangulation, with no seam along the block cuts, on every 2-D domain. The last set
- * has points off the plane's edges, whose hull edges span the blocks: it falls back to one block. */
+ * one Delaunay triangulation, with no seam along the block cuts, on every 2-D domain. In the last
+ * set a notch in the bottom edge is bridged by a hull edge across the cut between the blocks: the
+ * triangulation falls back to one block. */
 static void test_blocks(void)
 {
     double w = 27.0, h = 26.0;
     int gx = 270, gy = 260;
     for (int k = 0; k < 4; k++) {
         bool wx = k == 1 || k == 2, wy = k == 2;
-        fs_points p = k == 3 ? jittered_points(gx, gy, w, h, 102) : clamped_points(gx, gy, w, h, wx, wy, 101);
+        fs_points p = clamped_points(gx, gy, w, h, wx, wy, 101);
+        if (k == 3) {
+            /* a notch in the middle of the bottom edge, bridged by one long hull edge */
+            int32_t kept = 0;
+            for (int32_t i = 0; i < p.n; i++) {
+                const double *q = p.p + 3 * i;
+                if (fabs(q[0] - 0.5 * w) < 4.0 && q[1] < 2.0)
+                    continue;
+                memmove(p.p + 3 * kept++, q, 3 * sizeof *q);
+            }
+            p.n = kept;
+        }
         fs_domain d = plane_domain(w, h, wx, wy);
         fs_mesh m;
         CHECK(fs_delaunay(&d, &p, &m) == 0);
@@ -894,6 +930,7 @@ int main(void)
     RUN(test_adjacency);
     RUN(test_plane_random);
     RUN(test_plane_lattice);
+    RUN(test_plane_square_grid);
     RUN(test_torus);
     RUN(test_torus_square_grid);
     RUN(test_torus_tiny);

@@ -2,8 +2,8 @@
 #include "geom/delaunay.h"
 
 #include <libqhull_r/libqhull_r.h>
-#include <pthread.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,7 +14,7 @@
 
 /* Two corners whose sine of angle is below this are treated as collinear (a zero-area triangle). */
 #define FLAT_SINE 1e-12
-/* Relative perturbation (of the mean spacing) that breaks cocircular ties on periodic domains. */
+/* Perturbation (in mean spacings) that breaks cocircular ties across seams and block cuts. */
 #define TIE_PERTURBATION 1e-6
 
 /* ---- Qhull ---- */
@@ -39,9 +39,13 @@ static void qhull_first_line(const char *msg, char *out, size_t size)
  * messages go to a memory stream, never to the user's terminal; the first line of an error report
  * becomes our message. Delaunay: "d Qbb Qc Qz Qt" lifts to the paraboloid (last coordinate scaled,
  * a point at infinity against cospherical input, triangulated output) and the lower facets are the
- * triangles. Sphere: "Qt" convex hull, each triangle turned to agree with Qhull's outward normal.
- * Returns triangles as point indices (Delaunay triangles unoriented). */
-static int run_qhull(int dim, int32_t npts, double *coords, bool delaunay, int32_t **tri_out, int64_t *ntri_out)
+ * triangles. Without `merge`, "Q0" also turns off Qhull's merging of nearly coplanar facets: a third
+ * faster on evenly spaced points, which are nearly cocircular everywhere; its rare failures (a
+ * Qhull precision error, or a mesh our checks reject) fall back to the merging run. Sphere: "Qt"
+ * convex hull, each triangle turned to agree with Qhull's outward normal. Returns triangles as point
+ * indices (Delaunay triangles unoriented). */
+static int run_qhull(int dim, int32_t npts, double *coords, bool delaunay, bool merge, int32_t **tri_out,
+                     int64_t *ntri_out)
 {
     *tri_out = NULL;
     *ntri_out = 0;
@@ -56,9 +60,11 @@ static int run_qhull(int dim, int32_t npts, double *coords, bool delaunay, int32
     }
     qhT *qh = fs_calloc(1, sizeof *qh);
     qh_zero(qh, err);
+    char flags_fast[] = "qhull d Qbb Qz Qt Q0";
     char flags_delaunay[] = "qhull d Qbb Qc Qz Qt";
     char flags_hull[] = "qhull Qt";
-    int code = qh_new_qhull(qh, dim, npts, coords, False, delaunay ? flags_delaunay : flags_hull, NULL, err);
+    char *flags = !delaunay ? flags_hull : (merge ? flags_delaunay : flags_fast);
+    int code = qh_new_qhull(qh, dim, npts, coords, False, flags, NULL, err);
 
     int rc = 0;
     int32_t *tri = NULL;
@@ -249,8 +255,6 @@ static bool is_flat(const double *a, const double *b, const double *c, double o)
 
 /* ---- mesh checks ---- */
 
-/* ---- mesh checks ---- */
-
 /* First node that is no triangle's corner, or -1. */
 static int32_t unused_node(const fs_mesh *m)
 {
@@ -379,7 +383,7 @@ static int triangulate_sphere(fs_mesh *m)
     memcpy(xyz, m->pos, 3 * (size_t)n * sizeof *xyz);
     int32_t *tri;
     int64_t nt;
-    int rc = run_qhull(3, n, xyz, false, &tri, &nt);
+    int rc = run_qhull(3, n, xyz, false, true, &tri, &nt);
     free(xyz);
     if (rc != 0)
         return -1;
@@ -442,6 +446,7 @@ typedef struct {
     double cut0, cut_width; /* block b covers [cut0 + b w, cut0 + (b + 1) w) along axis */
     double max_margin;    /* beyond this the input is taken as degenerate */
     double slack;         /* added to circumcircles against rounding (a billionth of the spacing) */
+    bool merge;           /* run Qhull with facet merging (see run_qhull) */
 } plane_setup;
 
 typedef struct {
@@ -519,6 +524,7 @@ static void run_block(block_job *job)
 {
     const plane_setup *s = job->s;
     int32_t n = s->n;
+    bool merge = s->merge;
     for (;;) {
         double lo[2], hi[2];
         block_region(s, job->b, job->margin, lo, hi);
@@ -570,7 +576,15 @@ static void run_block(block_job *job)
 
         int32_t *tri = NULL;
         int64_t nt = 0;
-        if (count < 3 || run_qhull(2, (int32_t)count, xy, true, &tri, &nt) != 0) {
+        int qrc = count < 3 ? -1 : run_qhull(2, (int32_t)count, xy, true, merge, &tri, &nt);
+        if (qrc != 0 && count >= 3 && !merge) {
+            free(xy);
+            free(node);
+            free(shift);
+            merge = true;
+            continue;
+        }
+        if (qrc != 0) {
             if (count < 3)
                 fs_error(FS_ERR_INTERNAL, "delaunay: block %d has only %lld points", job->b, (long long)count);
             free(xy);
@@ -696,9 +710,10 @@ typedef enum {
     MESH_DEGENERATE   /* not a valid mesh: ties split inconsistently, or a point is no vertex */
 } mesh_check;
 
-/* Checks the merged mesh: every node used, a manifold, and a boundary that is the true one (none on
- * a torus; along the lowest and highest rows across a band periodic in one direction; a convex
- * loop on the plane), and the Euler characteristic (0 for a torus or annulus, 1 for a disc). */
+/* Checks the merged mesh: every node used, a manifold, a boundary that is the true one (none on a
+ * torus; along the lowest and highest rows across a band periodic in one direction; a convex loop
+ * on the plane), the area of the periodic cell covered once, and the Euler characteristic (0 for
+ * a torus or annulus, 1 for a disc). */
 static mesh_check check_2d(fs_mesh *m, const plane_setup *s, int32_t *unused)
 {
     *unused = unused_node(m);
@@ -745,6 +760,16 @@ static mesh_check check_2d(fs_mesh *m, const plane_setup *s, int32_t *unused)
     free(out);
     if (result != MESH_OK)
         return result;
+    if (wrapping) {
+        /* signed areas sum to the cell's area only when the triangles cover it exactly once */
+        double area = 0.0, want = 1.0;
+        for (int32_t t = 0; t < m->n_tris; t++)
+            area += fs_mesh_tri_area(m, t);
+        for (int d = 0; d < 2; d++)
+            want *= s->period[d] > 0.0 ? s->period[d] : s->hi[d] - s->lo[d];
+        if (fabs(area - want) > 1e-9 * want)
+            return MESH_DEGENERATE;
+    }
     fs_mesh_build_edges(m);
     return euler_characteristic(m) == (wrapping ? 0 : 1) ? MESH_OK : MESH_DEGENERATE;
 }
@@ -840,16 +865,18 @@ static void setup_coordinates(const fs_mesh *m, plane_setup *s, bool perturb, do
 }
 
 /* design: the plane is the Delaunay triangulation by the paraboloid lift (thesis §5.2.2); a
- * periodic plane or cylinder (thesis §5.2.2 triangulates the unwrapped cylinder; we make it
- * seamless) triangulates the points with their images across the seams and keeps one copy of each
- * triangle (run_block). A large set is cut into blocks along its longer side, run in parallel; a
- * block is a periodic-copy problem of its own, with the other blocks' points as "images". The
- * number of blocks depends only on the point count, and the triangles are put in canonical order,
- * so the mesh does not depend on the machine. The merged mesh is checked (check_2d): if a
- * boundary is wrong the margins grow; cocircular points on a seam or a block cut may be split
- * differently on the two sides, and then we retry with every node moved by a fixed pseudo-random
- * offset of TIE_PERTURBATION spacings in the wrapping directions (the same for all its images, fed
- * only to Qhull), and then as one block. */
+ * periodic plane or cylinder (the thesis triangulates the unwrapped cylinder; we make it seamless)
+ * triangulates the points with their images across the seams and keeps one copy of each triangle
+ * (run_block). A large set is cut into blocks along its longer side, run in parallel: a block is
+ * the same problem with the other blocks' points in the role of images. The block count depends
+ * only on the input, and the triangles are put in canonical order, so the mesh does not depend on
+ * the machine or its thread count. Blocks need the points on the edges that do not wrap (the
+ * sampler snaps them there): otherwise a hull edge may span blocks, and one block is used. The
+ * merged mesh is checked (check_2d); any failure first reruns Qhull with facet merging, then a
+ * wrong boundary sends us to one block and grows the margin. Cocircular points on a seam or a
+ * block cut may be split differently on the two sides: then we retry with every node moved by a
+ * fixed pseudo-random offset of TIE_PERTURBATION spacings in the wrapping directions (the same for
+ * all its images, fed only to Qhull), then as one block. */
 static int triangulate_2d(fs_mesh *m)
 {
     int32_t n = m->n_nodes;
@@ -917,7 +944,15 @@ static int triangulate_2d(fs_mesh *m)
             rc = 0;
             break;
         }
-        if ((st == MESH_BLOCK_LIMIT || st == MESH_BOUNDARY) && s.nblocks > 1) {
+        if (st == MESH_BLOCK_LIMIT && s.nblocks > 1) {
+            s.nblocks = 1;
+            continue;
+        }
+        if (!s.merge) {
+            s.merge = true;
+            continue;
+        }
+        if (st == MESH_BOUNDARY && s.nblocks > 1) {
             s.nblocks = 1;
             continue;
         }

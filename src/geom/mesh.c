@@ -139,9 +139,42 @@ static void node_half_edges(const fs_mesh *m, int32_t **start_out, int32_t **lis
     *list_out = list;
 }
 
-/* design: the partner of half-edge a -> b is among the half-edges leaving b (about six), found
- * through the lists by start node: linear time, no global sort. A second half-edge a -> b in the
- * same direction means three triangles on one edge or two facing opposite ways. */
+/* Sorts keys (with their values) by an LSD radix sort on the low `bits` bits. */
+static void radix_sort(uint64_t *key, int32_t *val, int32_t n, int bits)
+{
+    enum { DIGIT = 11, BUCKETS = 1 << DIGIT };
+    uint64_t *key2 = fs_malloc((size_t)(n ? n : 1) * sizeof *key2);
+    int32_t *val2 = fs_malloc((size_t)(n ? n : 1) * sizeof *val2);
+    int32_t *count = fs_malloc(BUCKETS * sizeof *count);
+    for (int shift = 0; shift < bits; shift += DIGIT) {
+        memset(count, 0, BUCKETS * sizeof *count);
+        for (int32_t i = 0; i < n; i++)
+            count[(key[i] >> shift) & (BUCKETS - 1)]++;
+        int32_t sum = 0;
+        for (int d = 0; d < BUCKETS; d++) {
+            int32_t c = count[d];
+            count[d] = sum;
+            sum += c;
+        }
+        for (int32_t i = 0; i < n; i++) {
+            int32_t k = count[(key[i] >> shift) & (BUCKETS - 1)]++;
+            key2[k] = key[i];
+            val2[k] = val[i];
+        }
+        memcpy(key, key2, (size_t)n * sizeof *key);
+        memcpy(val, val2, (size_t)n * sizeof *val);
+    }
+    free(key2);
+    free(val2);
+    free(count);
+}
+
+/* design: every half-edge gets the key (smaller node, larger node, direction); a radix sort brings
+ * the two half-edges of an edge together (sequential passes, no random access per half-edge), and
+ * a run of equal node pairs is matched by image offset and direction: a partner runs the other way
+ * with the opposite offset. Runs longer than two are rare: tiny periodic meshes, where one pair of nodes
+ * has several edges, or a non-manifold mesh. A second half-edge along the same edge in the same
+ * direction means three triangles on one edge or two facing opposite ways. */
 int fs_mesh_build_adjacency(fs_mesh *m)
 {
     if ((int64_t)m->n_tris * 3 > INT32_MAX) {
@@ -151,39 +184,62 @@ int fs_mesh_build_adjacency(fs_mesh *m)
     int32_t nh = 3 * m->n_tris;
     free(m->adj);
     m->adj = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->adj);
-    int32_t *start, *list;
-    node_half_edges(m, &start, &list);
-    int32_t *end = fs_malloc((size_t)(nh ? nh : 1) * sizeof *end);
-    for (int32_t h = 0; h < nh; h++)
-        end[h] = m->tri[3 * (h / 3) + (h % 3 + 1) % 3];
+    int bits = 1;
+    while (bits < 31 && ((int64_t)1 << bits) < m->n_nodes)
+        bits++;
+    bool shifted = false;
+    for (int64_t k = 0; m->shift && k < 6 * (int64_t)m->n_tris && !shifted; k++)
+        shifted = m->shift[k] != 0;
+    /* key: the two nodes, then one bit for the direction (set when running from the larger) */
+    uint64_t *key = fs_malloc((size_t)(nh ? nh : 1) * sizeof *key);
+    int32_t *val = fs_malloc((size_t)(nh ? nh : 1) * sizeof *val);
+    for (int32_t h = 0; h < nh; h++) {
+        uint64_t a = (uint64_t)m->tri[h], b = (uint64_t)m->tri[3 * (h / 3) + (h % 3 + 1) % 3];
+        key[h] = a <= b ? ((a << bits | b) << 1) : ((b << bits | a) << 1) | 1;
+        val[h] = h;
+        m->adj[h] = -1;
+    }
+    radix_sort(key, val, nh, 2 * bits + 1);
+
     int rc = 0;
-    for (int32_t h = 0; h < nh && rc == 0; h++) {
-        half_edge e = half_edge_of(m, h);
-        int32_t match = -1, count = 0;
-        for (int32_t k = start[e.to]; k < start[e.to + 1]; k++) {
-            int32_t g = list[k];
-            if (end[g] == e.from && g != h && opposite(half_edge_of(m, g), e)) {
-                match = g;
-                count++;
+    for (int32_t i = 0; i < nh && rc == 0;) {
+        int32_t j = i + 1;
+        while (j < nh && key[j] >> 1 == key[i] >> 1)
+            j++;
+        if (!shifted && j - i <= 2 && key[i] != key[j - 1]) {
+            /* the common case off the seams: one half-edge each way */
+            m->adj[val[i]] = val[j - 1] / 3;
+            m->adj[val[j - 1]] = val[i] / 3;
+            i = j;
+            continue;
+        }
+        if (!shifted && j - i == 1) {
+            i = j;
+            continue;
+        }
+        for (int32_t p = i; p < j && rc == 0; p++) {
+            half_edge e = half_edge_of(m, val[p]);
+            for (int32_t q = p + 1; q < j; q++) {
+                half_edge f = half_edge_of(m, val[q]);
+                bool pair = opposite(e, f);
+                if (same_direction(e, f) || (pair && (m->adj[val[p]] >= 0 || m->adj[val[q]] >= 0))) {
+                    fs_error(FS_ERR_DATA,
+                             "mesh: edge (%d, %d) of triangle %d is shared by more than two triangles or by two "
+                             "facing opposite ways (non-manifold)",
+                             (int)e.from, (int)e.to, (int)(val[p] / 3));
+                    rc = -1;
+                    break;
+                }
+                if (pair) {
+                    m->adj[val[p]] = val[q] / 3;
+                    m->adj[val[q]] = val[p] / 3;
+                }
             }
         }
-        for (int32_t k = start[e.from]; k < start[e.from + 1] && count <= 1; k++) {
-            int32_t g = list[k];
-            if (end[g] == e.to && g != h && same_direction(half_edge_of(m, g), e))
-                count = 2;
-        }
-        if (count > 1) {
-            fs_error(FS_ERR_DATA,
-                     "mesh: edge (%d, %d) of triangle %d is shared by more than two triangles or by two facing "
-                     "opposite ways (non-manifold)",
-                     (int)e.from, (int)e.to, (int)(h / 3));
-            rc = -1;
-        }
-        m->adj[h] = match >= 0 ? match / 3 : -1;
+        i = j;
     }
-    free(start);
-    free(list);
-    free(end);
+    free(key);
+    free(val);
     return rc;
 }
 
@@ -478,6 +534,29 @@ static void boundary_normal(const fs_mesh *m, int32_t t, int i, double *n)
     n[1] = len > 0.0 ? -dx / len : 0.0;
 }
 
+/* The corners of node v in the order of its ring, with fan flags as walk_node gives them; false
+ * when a ring triangle holds v twice (tiny periodic meshes), which needs walk_node. */
+static bool ring_corners(const fs_mesh *m, int32_t v, int32_t *out, uint8_t *flags)
+{
+    int32_t s0 = m->ring_start[v], deg = m->ring_start[v + 1] - s0;
+    for (int32_t k = 0; k < deg; k++) {
+        int32_t t = m->ring_tri[s0 + k], found = 0;
+        for (int c = 0; c < 3; c++)
+            if (m->tri[3 * t + c] == v) {
+                out[k] = 3 * t + c;
+                found++;
+            }
+        if (found != 1)
+            return false;
+    }
+    for (int32_t k = 0; k < deg; k++) {
+        int32_t prev = k > 0 ? out[k - 1] : -1;
+        bool joined = prev >= 0 && m->adj[3 * (prev / 3) + (prev % 3 + 2) % 3] == out[k] / 3;
+        flags[k] = joined ? 0 : (uint8_t)(1 | (m->adj[out[k]] < 0 ? 2 : 0));
+    }
+    return true;
+}
+
 /* design: a node's Voronoi cell is the polygon of the circumcentres of its ring, in order (thesis
  * §5.2). On the plane and cylinder the circumcentres are brought into the node's frame with the
  * corner shifts; an open fan (a boundary node) is closed by two rays along the outward normals of
@@ -518,21 +597,25 @@ int fs_voronoi_build(const fs_mesh *m, fs_voronoi *out)
     clip_box box = make_box(m);
     double diag = sphere ? 0.0 : hypot(fs_domain_extent_x(&m->domain), fs_domain_extent_y(&m->domain));
 
-    int32_t *start, *corner;
-    node_half_edges(m, &start, &corner);
-    int32_t nh = 3 * nt;
-    uint8_t *visited = fs_calloc((size_t)(nh ? nh : 1), 1);
+    int32_t *start = NULL, *corner = NULL;
+    uint8_t *visited = NULL;
     int32_t maxdeg = 0;
     for (int32_t v = 0; v < m->n_nodes; v++)
-        if (start[v + 1] - start[v] > maxdeg)
-            maxdeg = start[v + 1] - start[v];
+        if (m->ring_start[v + 1] - m->ring_start[v] > maxdeg)
+            maxdeg = m->ring_start[v + 1] - m->ring_start[v];
     int32_t *order = fs_malloc((size_t)(maxdeg ? maxdeg : 1) * sizeof *order);
     uint8_t *flags = fs_malloc((size_t)(maxdeg ? maxdeg : 1));
     poly_buf poly = {NULL, NULL, NULL, NULL, 0};
 
     for (int32_t v = 0; v < m->n_nodes; v++) {
-        int32_t deg = start[v + 1] - start[v];
-        walk_node(m, corner + start[v], deg, visited, order, flags);
+        int32_t deg = m->ring_start[v + 1] - m->ring_start[v];
+        if (!ring_corners(m, v, order, flags)) {
+            if (!start) {
+                node_half_edges(m, &start, &corner);
+                visited = fs_calloc((size_t)3 * (size_t)nt + 1, 1);
+            }
+            walk_node(m, corner + start[v], deg, visited, order, flags);
+        }
         const double *pv = m->pos + 3 * (size_t)v;
         double area = 0.0;
         for (int32_t f = 0; f < deg;) {
@@ -561,7 +644,8 @@ int fs_voronoi_build(const fs_mesh *m, fs_voronoi *out)
                     int32_t k = order[i];
                     int32_t t = (int32_t)(k / 3);
                     int c = (int)(k % 3);
-                    const int8_t *s = m->shift + 6 * (size_t)t + 2 * c;
+                    static const int8_t no_shift[2] = {0, 0};
+                    const int8_t *s = m->shift ? m->shift + 6 * (size_t)t + 2 * c : no_shift;
                     const double *cc = out->circumcenter + 3 * (size_t)t;
                     double x = cc[0] - s[0] * px - pv[0], y = cc[1] - s[1] * py - pv[1];
                     poly.x[i - f] = x;
@@ -590,7 +674,13 @@ int fs_voronoi_build(const fs_mesh *m, fs_voronoi *out)
                     poly.y[cnt + 2] = yf + reach * n_first[1];
                     cnt += 3;
                 }
-                area += clipped_area(&poly, cnt, &box, pv);
+                bool inside = true;
+                for (int i = 0; i < cnt && inside; i++)
+                    for (int k = 0; k < 2; k++) {
+                        double q = (k ? poly.y[i] : poly.x[i]) + pv[k];
+                        inside &= !box.clip[k] || (q >= box.lo[k] && q <= box.hi[k]);
+                    }
+                area += inside ? polygon_area(poly.x, poly.y, cnt) : clipped_area(&poly, cnt, &box, pv);
             }
             f = e;
         }
@@ -629,13 +719,17 @@ int fs_voronoi_build(const fs_mesh *m, fs_voronoi *out)
             len = r * atan2(fs_norm3(cr), fs_dot3(ct, q));
         } else if (u >= 0) {
             /* bring u's circumcentre into t's frame through the shared corner */
-            int32_t g = partner(m, h);
-            int ct_corner = i, cu_corner = (int)((g % 3 + 1) % 3);
-            const int8_t *st = m->shift + 6 * (size_t)t + 2 * ct_corner;
-            const int8_t *su = m->shift + 6 * (size_t)u + 2 * cu_corner;
+            double off[2] = {0.0, 0.0};
+            if (m->shift && (px > 0.0 || py > 0.0)) {
+                int32_t g = partner(m, h);
+                const int8_t *st = m->shift + 6 * (size_t)t + 2 * i;
+                const int8_t *su = m->shift + 6 * (size_t)u + 2 * ((g % 3 + 1) % 3);
+                off[0] = (st[0] - su[0]) * px;
+                off[1] = (st[1] - su[1]) * py;
+            }
             const double *cu = out->circumcenter + 3 * (size_t)u;
             double p0[2] = {ct[0], ct[1]};
-            double d[2] = {cu[0] + (st[0] - su[0]) * px - ct[0], cu[1] + (st[1] - su[1]) * py - ct[1]};
+            double d[2] = {cu[0] + off[0] - ct[0], cu[1] + off[1] - ct[1]};
             double t0 = 0.0, t1 = 1.0;
             if (clip_line(&box, p0, d, &t0, &t1))
                 len = (t1 - t0) * hypot(d[0], d[1]);
