@@ -660,13 +660,16 @@ int fs_sample_repulsion(const fs_domain *domain, const fs_sample_params *params,
         relax_step(&s, STEP0 * damp * s.spacing, MAXMOVE0 * damp * s.spacing);
     }
 
+    /* Points come out in the order of the last bucket sort (grid cells row by row): spatially
+     * coherent, which makes the Delaunay triangulation and the mesh passes after it cache-friendly. */
+    bucket_sort(&s);
     out->p = fs_malloc((size_t)n * 3 * sizeof(double));
     out->n = n;
     for (int32_t k = 0; k < n; k++) {
-        double *p = out->p + 3 * (size_t)s.id[k];
-        p[0] = s.x[0][k];
-        p[1] = s.x[1][k];
-        p[2] = s.sphere ? s.x[2][k] : 0.0;
+        double *p = out->p + 3 * (size_t)k;
+        p[0] = s.sx[0][k];
+        p[1] = s.sx[1][k];
+        p[2] = s.sphere ? s.sx[2][k] : 0.0;
     }
     free_state(&s);
     return 0;
