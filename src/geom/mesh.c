@@ -522,9 +522,7 @@ static double clipped_area(poly_buf *p, int n, const clip_box *box, const double
     return a;
 }
 
-/* Outward unit normal of the boundary edge from corner i to corner (i + 1) % 3 of triangle t (the
- * triangle lies to its left), in the frame of t. */
-static void boundary_normal(const fs_mesh *m, int32_t t, int i, double *n)
+void fs_mesh_boundary_normal(const fs_mesh *m, int32_t t, int i, double *n)
 {
     double a[3], b[3];
     fs_mesh_corner(m, t, i, a);
@@ -658,8 +656,8 @@ int fs_voronoi_build(const fs_mesh *m, fs_voronoi *out)
                     /* rays dual to the two boundary edges, closed far outside the domain */
                     double n_first[2], n_last[2];
                     int32_t tf = (int32_t)(order[f] / 3), tl = (int32_t)(order[e - 1] / 3);
-                    boundary_normal(m, tf, (int)(order[f] % 3), n_first);
-                    boundary_normal(m, tl, (int)((order[e - 1] % 3 + 2) % 3), n_last);
+                    fs_mesh_boundary_normal(m, tf, (int)(order[f] % 3), n_first);
+                    fs_mesh_boundary_normal(m, tl, (int)((order[e - 1] % 3 + 2) % 3), n_last);
                     double reach = 4.0 * (diag + far) + 1.0;
                     double ang = atan2(n_last[0] * n_first[1] - n_last[1] * n_first[0],
                                        n_last[0] * n_first[0] + n_last[1] * n_first[1]);
@@ -735,7 +733,7 @@ int fs_voronoi_build(const fs_mesh *m, fs_voronoi *out)
                 len = (t1 - t0) * hypot(d[0], d[1]);
         } else {
             double n[2], p0[2] = {ct[0], ct[1]};
-            boundary_normal(m, t, i, n);
+            fs_mesh_boundary_normal(m, t, i, n);
             double t0 = 0.0, t1 = INFINITY;
             if (clip_line(&box, p0, n, &t0, &t1)) {
                 if (isfinite(t1)) {

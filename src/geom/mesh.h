@@ -59,6 +59,10 @@ void fs_mesh_build_rings(fs_mesh *m);
 /* Unwrapped position of corner c (0..2) of triangle t (see the design note). out has 3 components. */
 void fs_mesh_corner(const fs_mesh *m, int32_t t, int c, double *out);
 
+/* Outward unit normal (x, y; z = 0) of the boundary edge from corner i to corner (i+1)%3 of triangle t
+ * (plane and cylinder; the triangle lies to the edge's left), in the unwrapped frame of t. */
+void fs_mesh_boundary_normal(const fs_mesh *m, int32_t t, int i, double *n);
+
 /* Signed area of triangle t (cm^2; positive when correctly oriented). */
 double fs_mesh_tri_area(const fs_mesh *m, int32_t t);
 

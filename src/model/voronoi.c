@@ -168,17 +168,6 @@ static int corner_of(const fs_mesh *m, int32_t t, int32_t node)
     return 0;
 }
 
-/* Outward unit normal (x, y) of the boundary edge from corner i to corner (i + 1) % 3 of t. */
-static void boundary_normal(const fs_mesh *m, int32_t t, int i, double *n)
-{
-    double a[3], b[3];
-    fs_mesh_corner(m, t, i, a);
-    fs_mesh_corner(m, t, (i + 1) % 3, b);
-    double dx = b[0] - a[0], dy = b[1] - a[1], len = hypot(dx, dy);
-    n[0] = len > 0.0 ? dy / len : 0.0;
-    n[1] = len > 0.0 ? -dx / len : 0.0;
-}
-
 static void project_sphere(double radius, double *p)
 {
     double r = fs_norm3(p);
@@ -258,8 +247,8 @@ static bool cell_polygon(ctx *c, int32_t node)
     int32_t tl = m->ring_tri[r1 - 1];
     int cl = corner_of(m, tl, node);
     double n_first[2], n_last[2], bis[2];
-    boundary_normal(m, tf, cf, n_first);
-    boundary_normal(m, tl, (cl + 2) % 3, n_last);
+    fs_mesh_boundary_normal(m, tf, cf, n_first);
+    fs_mesh_boundary_normal(m, tl, (cl + 2) % 3, n_last);
     bis[0] = n_first[0] + n_last[0];
     bis[1] = n_first[1] + n_last[1];
     double len = hypot(bis[0], bis[1]);
