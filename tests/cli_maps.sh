@@ -20,7 +20,8 @@ run_small() { # NAME PRESET W H [extra options]
         not_ok "$name.json exists"
     fi
     n=$(wc -l < "$tmp/stdout")
-    [ "$n" -eq 7 ] && ok "stdout lists the 7 files written" || not_ok "stdout lists the 7 files written (got $n lines)"
+    # 8 maps (with the preview and the occlusion), the crack graph's JSON and SVG, the sidecar.
+    [ "$n" -eq 11 ] && ok "stdout lists the 11 files written" || not_ok "stdout lists the 11 files written (got $n lines)"
     leftovers=$(find "$d" -name '.*tmp*' | wc -l)
     [ "$leftovers" -eq 0 ] && ok "no temporary file is left" || not_ok "no temporary file is left"
 }

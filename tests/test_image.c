@@ -266,9 +266,39 @@ static void test_write_error(void)
     fs_image_free(&a);
 }
 
+/* An sRGB-tagged PNG has the chunk right after IHDR (13 bytes: length 1, "sRGB", intent 0, and
+ * the CRC-32 of "sRGB\0", 0xaece1ce9, as zlib's crc32 gives it), decodes to
+ * the same pixels, and an untagged one has no colour chunk. */
+static void test_srgb_tag(void)
+{
+    fs_image a, b = {0};
+    fs_image_alloc(&a, 9, 7, 3, FS_PIX_U8);
+    for (size_t k = 0; k < fs_image_bytes(&a); k++)
+        ((uint8_t *)a.data)[k] = (uint8_t)pattern(k);
+    CHECK(fs_image_write_tagged(tmp_path("tagged.png"), &a, FS_IMAGE_SRGB) == 0);
+    CHECK(fs_image_write_tagged(tmp_path("plain.png"), &a, FS_IMAGE_UNTAGGED) == 0);
+    static const uint8_t chunk[13] = {0, 0, 0, 1, 's', 'R', 'G', 'B', 0, 0xae, 0xce, 0x1c, 0xe9};
+    uint8_t head[46] = {0};
+    FILE *f = fopen(tmp_path("tagged.png"), "rb");
+    CHECK(f && fread(head, 1, sizeof head, f) == sizeof head);
+    if (f)
+        fclose(f);
+    CHECK(memcmp(head + 12, "IHDR", 4) == 0 && memcmp(head + 33, chunk, sizeof chunk) == 0);
+    f = fopen(tmp_path("plain.png"), "rb");
+    CHECK(f && fread(head, 1, sizeof head, f) == sizeof head);
+    if (f)
+        fclose(f);
+    CHECK(memcmp(head + 37, "IDAT", 4) == 0);
+    CHECK(fs_image_read(tmp_path("tagged.png"), &b) == 0);
+    CHECK(b.data && fs_image_bytes(&b) == fs_image_bytes(&a) && memcmp(a.data, b.data, fs_image_bytes(&a)) == 0);
+    fs_image_free(&a);
+    fs_image_free(&b);
+}
+
 static void remove_tmpdir(void)
 {
-    const char *names[] = {"g8.png", "rgb8.png", "g16.png", "rgb16.png", "g.exr", "rgb.exr", "red.png", "junk.png"};
+    const char *names[] = {"g8.png", "rgb8.png", "g16.png", "rgb16.png", "g.exr", "rgb.exr", "red.png", "junk.png",
+                           "tagged.png", "plain.png"};
     for (size_t k = 0; k < sizeof names / sizeof *names; k++)
         unlink(tmp_path(names[k]));
     rmdir(tmpdir);
@@ -292,6 +322,7 @@ int main(void)
     RUN(test_downsample);
     RUN(test_read_errors);
     RUN(test_write_error);
+    RUN(test_srgb_tag);
     remove_tmpdir();
     return check_finish();
 }

@@ -299,7 +299,7 @@ static void test_errors(void)
     static const error_case cases[] = {
         {"[preset]\nname = a\n[colour]\nx = 1\n",
          "t.ini:3: unknown section [colour]: expected one of: preset, domain, mesh, material, growth, shrink, "
-         "fracture, time, render, voronoi"},
+         "fracture, time, render, voronoi, solver, wedge, springs"},
         {"[mesh]\n\nelement = 100\n",
          "t.ini:3: unknown key [mesh] element: expected one of: elements, min_size, lattice, relax_iterations, "
          "radius_jitter"},
@@ -417,7 +417,7 @@ static void test_set(void)
         {"a.b.c=5", FS_ERR_USAGE, "--set: expected SECTION.KEY=VALUE, got 'a.b.c=5'"},
         {"meshes.elements=5", FS_ERR_USAGE,
          "--set meshes.elements: unknown section [meshes]: expected one of: preset, domain, mesh, material, growth, "
-         "shrink, fracture, time, render, voronoi"},
+         "shrink, fracture, time, render, voronoi, solver, wedge, springs"},
         {"time.stop=5", FS_ERR_USAGE, "--set time.stop: unknown key [time] stop: expected one of: end, min_step"},
         {"mesh.elements=lots", FS_ERR_DATA, "--set mesh.elements: expected an integer in 16..20000000, got 'lots'"},
         {"render.normal=up", FS_ERR_DATA, "--set render.normal: expected opengl or directx, got 'up'"},

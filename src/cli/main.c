@@ -11,15 +11,23 @@
 #include "base/log.h"
 #include "cli/cli.h"
 #include "config.h"
+#include "io/obj.h"
 #include "io/output.h"
 #include "io/preset.h"
 #include "io/sidecar.h"
+#include "io/target.h"
+#include "render/crackgraph.h"
+#include "render/occlusion.h"
 #include "render/render.h"
 #include "sim/sim.h"
 
-enum { MAP_HEIGHT, MAP_NORMAL, MAP_BASECOLOR, MAP_CRACKMASK, MAP_CRACKDIST, MAP_CELLID, MAP_COUNT };
-static const char *const map_names[MAP_COUNT] = {"height", "normal", "basecolor", "crackmask", "crackdist", "cellid"};
-static const char *const map_color_spaces[MAP_COUNT] = {"linear", "data", "srgb", "linear", "linear", "data"};
+enum {
+    MAP_HEIGHT, MAP_NORMAL, MAP_BASECOLOR, MAP_CRACKMASK, MAP_CRACKDIST, MAP_CELLID, MAP_PREVIEW, MAP_OCCLUSION,
+    MAP_CRACKS, MAP_COUNT
+};
+/* Map kinds; io/target.h names, packs and tags their files per engine. */
+static const char *const map_names[MAP_COUNT] = {"height", "normal", "basecolor", "crackmask", "crackdist", "cellid",
+                                                 "preview", "occlusion", "cracks"};
 
 typedef struct {
     const char *output_dir;
@@ -35,10 +43,12 @@ typedef struct {
     bool have_normal;
     fs_normal_convention normal;
     bool list_presets, dump_preset;
+    fs_target target;      /* --target: the engine the maps are named, packed and oriented for */
+    const char *mesh_path; /* --mesh FILE: the lifted 3-D layer as Wavefront OBJ, or NULL */
 } options;
 
 enum {
-    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP
+    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET
 };
 
 static const struct option long_options[] = {
@@ -50,10 +60,12 @@ static const struct option long_options[] = {
     {"maps", required_argument, NULL, OPT_MAPS},
     {"format", required_argument, NULL, OPT_FORMAT},
     {"normal", required_argument, NULL, OPT_NORMAL},
+    {"target", required_argument, NULL, OPT_TARGET},
     {"quiet", no_argument, NULL, 'q'},
     {"verbose", no_argument, NULL, 'v'},
     {"list-presets", no_argument, NULL, OPT_LIST},
     {"dump-preset", no_argument, NULL, OPT_DUMP},
+    {"mesh", required_argument, NULL, OPT_MESH},
     {"help", no_argument, NULL, 'h'},
     {"version", no_argument, NULL, 'V'},
     {NULL, 0, NULL, 0},
@@ -73,10 +85,14 @@ static void print_help(FILE *out)
           "      --set SECTION.KEY=VALUE\n"
           "                          override one preset key (repeatable)\n"
           "      --maps LIST         comma-separated maps to write: height, normal, basecolor,\n"
-          "                          crackmask, crackdist, cellid, or all (default: all)\n"
+          "                          crackmask, crackdist, cellid, preview, occlusion, cracks\n"
+          "                          (crack graph JSON and SVG), or all (default: all)\n"
           "      --format png|exr    height map as 16-bit PNG (default) or float EXR in cm\n"
           "      --normal opengl|directx\n"
           "                          normal map convention (default: opengl, +Y up)\n"
+          "      --target ENGINE     name, pack and orient the maps for generic (default), gltf,\n"
+          "                          unreal, unity-hdrp or blender\n"
+          "      --mesh FILE         also write the cracked 3-D layer to FILE as Wavefront OBJ\n"
           "  -q, --quiet             print nothing on stderr but errors\n"
           "  -v, --verbose           print details of each phase on stderr\n"
           "      --list-presets      list the presets on the preset path, one a line, and exit\n"
@@ -171,7 +187,8 @@ static int parse_options(int argc, char **argv, options *o)
         case OPT_MAPS:
             if (!parse_maps(optarg, o->maps))
                 return usage_error("--maps: expected a comma-separated list of height, normal, basecolor, "
-                                   "crackmask, crackdist, cellid or all, got '%s'", optarg);
+                                   "crackmask, crackdist, cellid, preview, occlusion, cracks or all, got '%s'",
+                                   optarg);
             break;
         case OPT_FORMAT:
             if (strcmp(optarg, "png") && strcmp(optarg, "exr"))
@@ -184,14 +201,31 @@ static int parse_options(int argc, char **argv, options *o)
             o->have_normal = true;
             o->normal = strcmp(optarg, "directx") ? FS_NORMAL_OPENGL : FS_NORMAL_DIRECTX;
             break;
+        case OPT_TARGET:
+            if (fs_target_parse(optarg, &o->target) < 0)
+                return usage_error("--target: expected generic, gltf, unreal, unity-hdrp or blender, got '%s'",
+                                   optarg);
+            break;
         case 'q': fs_log_set_level(FS_LOG_QUIET); break;
         case 'v': fs_log_set_level(FS_LOG_VERBOSE); break;
         case OPT_LIST: o->list_presets = true; break;
         case OPT_DUMP: o->dump_preset = true; break;
+        case OPT_MESH:
+            if (!*optarg || optarg[strlen(optarg) - 1] == '/')
+                return usage_error("--mesh: expected a file name, got '%s'", optarg);
+            o->mesh_path = optarg;
+            break;
         case 'h': print_help(stdout); return -1;
         case 'V': printf("fissure %s\n", PACKAGE_VERSION); return -1;
         default: fputs("Try 'fissure --help' for more information.\n", stderr); return FS_ERR_USAGE;
         }
+    }
+    if (o->have_normal && fs_target_fixes_normal(o->target) && o->normal != fs_target_normal(o->target)) {
+        char what[160];
+        snprintf(what, sizeof what, "--normal %s conflicts with --target %s, whose normal maps are %s",
+                 o->normal == FS_NORMAL_DIRECTX ? "directx" : "opengl", fs_target_name(o->target),
+                 fs_target_normal(o->target) == FS_NORMAL_DIRECTX ? "directx" : "opengl");
+        return usage_error("%s", what);
     }
     return 0;
 }
@@ -241,56 +275,127 @@ static int load_config(const char *arg, const options *o, fs_config *cfg, char *
     }
     if (o->have_normal)
         cfg->render.normal = o->normal;
+    if (fs_target_fixes_normal(o->target))
+        cfg->render.normal = fs_target_normal(o->target);
     return fs_preset_validate(cfg, *preset_path);
 }
 
-/* Writes the selected maps and the sidecar as one atomic output set; prints the final paths. */
+/* Lifts the result into 3-D and stages it as OBJ in the directory of path, which may lie outside
+ * the output directory. Returns the staged output set, or NULL with fs_error. */
+static fs_output *stage_mesh(const char *path, const fs_config *cfg, const fs_result *res, const char *name)
+{
+    char *dir = fs_strdup(path);
+    char *slash = strrchr(dir, '/');
+    const char *file = slash ? path + (slash - dir) + 1 : path;
+    if (!slash)
+        strcpy(dir, ".");
+    else
+        slash[slash == dir ? 1 : 0] = '\0';
+    fs_output *out = fs_output_begin(dir);
+    free(dir);
+    if (!out)
+        return NULL;
+    fs_lifted_mesh lifted;
+    int rc = fs_render_mesh_lift(&res->surface, &cfg->domain, 1.0, &lifted);
+    if (rc == 0) {
+        char comment[200];
+        snprintf(comment, sizeof comment, "fissure %s: preset %s, seed %" PRIu64 ", %s model on a %s", PACKAGE_VERSION,
+                 cfg->preset.name, cfg->preset.seed, fs_model_name(cfg->preset.model),
+                 fs_domain_type_name(cfg->domain.type));
+        rc = fs_obj_write(fs_output_stage(out, file), &lifted, name, comment);
+    }
+    fs_lifted_mesh_free(&lifted);
+    if (rc < 0) {
+        fs_output_abort(out);
+        return NULL;
+    }
+    return out;
+}
+
+/* Writes the selected maps, the sidecar and the --mesh file as one atomic output set; prints the
+ * final paths. */
 static int write_outputs(const options *o, const fs_config *cfg, const char *name, const char *preset_text,
-                         const fs_result *res, const fs_raster *raster, const fs_maps *maps, double t_start)
+                         const fs_result *res, const fs_raster *raster, const fs_maps *maps, const fs_image *preview,
+                         double t_start)
 {
     fs_output *out = fs_output_begin(o->output_dir);
     if (!out)
         return -1;
-    const fs_image *images[MAP_COUNT] = {&maps->height, &maps->normal, &maps->basecolor,
-                                         &maps->crackmask, &maps->crackdist, &maps->cellid};
-    fs_image exr_height = {0};
-    fs_sidecar_map list[MAP_COUNT];
-    char files[MAP_COUNT][600];
-    int n = 0;
+    fs_image exr_height = {0}, occlusion = {0};
+    fs_crackgraph cracks = {0};
+    fs_target_output *written = fs_calloc(1, sizeof *written);
+    fs_domain d = cfg->domain;
+    fs_domain_normalize(&d);
+    bool wu = fs_domain_wraps_u(&d), wv = fs_domain_wraps_v(&d);
     int rc = 0;
-    for (int i = 0; i < MAP_COUNT && rc == 0; i++) {
-        if (!o->maps[i])
-            continue;
-        const fs_image *img = images[i];
-        const char *ext = "png";
-        if (i == MAP_HEIGHT && o->exr) {
-            /* Float height in cm at full precision, straight from the raster. */
-            fs_image_alloc(&exr_height, raster->width, raster->height, 1, FS_PIX_F32);
-            memcpy(exr_height.data, raster->height_cm, fs_image_bytes(&exr_height));
-            img = &exr_height;
-            ext = "exr";
-        }
-        snprintf(files[n], sizeof files[n], "%s_%s.%s", name, map_names[i], ext);
-        rc = fs_image_write(fs_output_stage(out, files[n]), img);
-        list[n] = (fs_sidecar_map){map_names[i], files[n], img, map_color_spaces[i]};
-        n++;
+    if (o->maps[MAP_HEIGHT] && o->exr) {
+        /* Float height in cm at full precision, straight from the raster. */
+        fs_image_alloc(&exr_height, raster->width, raster->height, 1, FS_PIX_F32);
+        memcpy(exr_height.data, raster->height_cm, fs_image_bytes(&exr_height));
     }
+    if (o->maps[MAP_OCCLUSION]) {
+        fs_occlusion_params op = fs_occlusion_params_default();
+        rc = fs_occlusion_build(raster, &op, wu, wv, &occlusion);
+    }
+    if (rc == 0 && o->maps[MAP_CRACKS]) {
+        double t_graph = fs_seconds();
+        fs_crackgraph_params cp = fs_crackgraph_params_default();
+        rc = fs_crackgraph_build(raster, wu, wv, &cp, &cracks);
+        fs_debug("crack graph: %d cracks, %d nodes, %d fragments in %.2f s", (int)cracks.n_edges,
+                 (int)cracks.n_nodes, (int)cracks.n_fragments, fs_seconds() - t_graph);
+    }
+    const char *kinds[MAP_COUNT];
+    int n_kinds = 0;
+    for (int i = 0; i < MAP_COUNT; i++)
+        if (o->maps[i])
+            kinds[n_kinds++] = map_names[i];
+    fs_target_inputs in = {.maps = maps,
+                           .height = o->exr ? &exr_height : &maps->height,
+                           .height_ext = o->exr ? "exr" : "png",
+                           .preview = preview,
+                           .occlusion = &occlusion,
+                           .roughness = cfg->render.roughness,
+                           .normal = cfg->render.normal,
+                           .cracks = &cracks};
+    if (rc == 0)
+        rc = fs_target_write(out, o->target, name, kinds, n_kinds, &in, written);
+    fs_image_free(&occlusion);
+    fs_crackgraph_free(&cracks);
+    fs_output *mesh_out = NULL;
+    if (rc == 0 && o->mesh_path && !(mesh_out = stage_mesh(o->mesh_path, cfg, res, name)))
+        rc = -1;
     char json_name[600];
     snprintf(json_name, sizeof json_name, "%s.json", name);
     if (rc == 0)
-        rc = fs_sidecar_write(fs_output_stage(out, json_name), cfg, preset_text, &res->stats, maps, list, n,
-                              fs_seconds() - t_start);
+        rc = fs_sidecar_write(fs_output_stage(out, json_name), cfg, preset_text, &res->stats, maps,
+                              fs_target_name(o->target), written->map, written->n, fs_seconds() - t_start);
+    fs_target_output_free(written);
+    const int n = written->n;
     if (rc < 0) {
+        free(written);
         fs_image_free(&exr_height);
         fs_output_abort(out);
+        if (mesh_out)
+            fs_output_abort(mesh_out);
         return -1;
     }
     fs_image_free(&exr_height);
-    if (fs_output_commit(out) < 0)
+    if (fs_output_commit(out) < 0) {
+        free(written);
+        if (mesh_out)
+            fs_output_abort(mesh_out);
         return -1;
+    }
+    if (mesh_out && fs_output_commit(mesh_out) < 0) {
+        free(written);
+        return -1;
+    }
     for (int i = 0; i < n; i++)
-        printf("%s/%s\n", o->output_dir, files[i]);
+        printf("%s/%s\n", o->output_dir, written->file[i]);
+    free(written);
     printf("%s/%s\n", o->output_dir, json_name);
+    if (o->mesh_path)
+        printf("%s\n", o->mesh_path);
     return 0;
 }
 
@@ -318,6 +423,7 @@ static int run(const char *preset_arg, const options *o)
     fs_result res;
     fs_raster raster = {0};
     fs_maps maps = {0};
+    fs_image preview = {0};
     int rc = fs_sim_run(&cfg, &res);
     if (rc == 0) {
         fs_domain d = cfg.domain;
@@ -331,13 +437,16 @@ static int run(const char *preset_arg, const options *o)
         if (rc == 0)
             rc = fs_maps_build(&raster, &cfg.render, wu, wv, fs_domain_extent_x(&d) / cfg.render.width,
                                fs_domain_extent_y(&d) / cfg.render.height, &maps);
+        if (rc == 0 && o->maps[MAP_PREVIEW])
+            rc = fs_render_preview(&res.surface, &d, &cfg.render, &maps, &preview);
         fs_progress_done();
         fs_debug("rendered in %.2f s", fs_seconds() - t_render);
         if (rc == 0)
-            rc = write_outputs(o, &cfg, name, preset_text, &res, &raster, &maps, t_start);
+            rc = write_outputs(o, &cfg, name, preset_text, &res, &raster, &maps, &preview, t_start);
         fs_result_free(&res);
     }
     fs_maps_free(&maps);
+    fs_image_free(&preview);
     fs_raster_free(&raster);
     free(preset_text);
     if (rc < 0)

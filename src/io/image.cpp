@@ -225,7 +225,70 @@ extern "C" int fs_image_read_grey(const char *path, int *width, int *height, flo
     return -1;
 }
 
+/* CRC-32 of the PNG specification (ISO 3309 / ITU-T V.42, reflected polynomial 0xEDB88320) over
+ * a chunk's type and data, computed bitwise: chunks we add are a few bytes long. */
+static uint32_t png_crc(const unsigned char *p, size_t n)
+{
+    uint32_t c = 0xffffffffu;
+    for (size_t i = 0; i < n; i++) {
+        c ^= p[i];
+        for (int k = 0; k < 8; k++)
+            c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+    }
+    return c ^ 0xffffffffu;
+}
+
+static void put_be32(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)(v >> 24);
+    p[1] = (unsigned char)(v >> 16);
+    p[2] = (unsigned char)(v >> 8);
+    p[3] = (unsigned char)v;
+}
+
+/* design: OpenCV's PNG encoder writes no colour chunk and has no option to add one, so the
+ * encoded stream is edited: the 8-byte signature and the IHDR chunk (4 length + 4 type + 13 data +
+ * 4 CRC = 25 bytes) come first, and PNG requires sRGB before PLTE and IDAT, so the chunk goes
+ * right after IHDR. Rendering intent 0 (perceptual) is what sRGB-tagged textures conventionally use. */
+static bool insert_srgb_chunk(std::vector<unsigned char> &png)
+{
+    const size_t ihdr_end = 8 + 25;
+    if (png.size() < ihdr_end || memcmp(&png[12], "IHDR", 4) != 0)
+        return false;
+    unsigned char chunk[13];
+    put_be32(chunk, 1);
+    memcpy(chunk + 4, "sRGB", 4);
+    chunk[8] = 0;
+    put_be32(chunk + 9, png_crc(chunk + 4, 5));
+    png.insert(png.begin() + (std::ptrdiff_t)ihdr_end, chunk, chunk + sizeof chunk);
+    return true;
+}
+
+/* Writes bytes to exactly path. */
+static int write_bytes(const char *path, const std::vector<unsigned char> &bytes)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) {
+        fs_error(FS_ERR_IO, "%s: cannot write image: %s", path, strerror(errno));
+        return -1;
+    }
+    size_t wrote = fwrite(bytes.data(), 1, bytes.size(), f);
+    int err = wrote == bytes.size() ? 0 : errno;
+    if (fclose(f) != 0 && err == 0)
+        err = errno ? errno : EIO;
+    if (wrote != bytes.size() || err) {
+        fs_error(FS_ERR_IO, "%s: cannot write image: %s", path, strerror(err ? err : EIO));
+        return -1;
+    }
+    return 0;
+}
+
 extern "C" int fs_image_write(const char *path, const fs_image *img)
+{
+    return fs_image_write_tagged(path, img, FS_IMAGE_UNTAGGED);
+}
+
+extern "C" int fs_image_write_tagged(const char *path, const fs_image *img, fs_image_tag tag)
 {
     bool exr = has_extension(path, ".exr");
     bool png = has_extension(path, ".png");
@@ -257,6 +320,14 @@ extern "C" int fs_image_write(const char *path, const fs_image *img)
         } else if (exr) {
             params.push_back(cv::IMWRITE_EXR_TYPE);
             params.push_back(cv::IMWRITE_EXR_TYPE_FLOAT);
+        }
+        if (png && tag == FS_IMAGE_SRGB) {
+            std::vector<unsigned char> bytes;
+            if (!cv::imencode(".png", m, bytes, params) || !insert_srgb_chunk(bytes)) {
+                fs_error(FS_ERR_INTERNAL, "%s: cannot encode PNG", path);
+                return -1;
+            }
+            return write_bytes(path, bytes);
         }
         if (!cv::imwrite(path, m, params)) {
             fs_error(FS_ERR_IO, "%s: cannot write image", path);

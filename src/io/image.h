@@ -36,6 +36,17 @@ int fs_image_read_grey(const char *path, int *width, int *height, float **grey);
  * io/output.h stages files under temporary names. Returns 0 or -1 with fs_error(FS_ERR_IO). */
 int fs_image_write(const char *path, const fs_image *img);
 
+/* How a PNG declares the colour space of its pixels. */
+typedef enum {
+    FS_IMAGE_UNTAGGED = 0, /* no colour chunk: data (heights, normals, masks, ids) read as raw values */
+    FS_IMAGE_SRGB = 1      /* an sRGB chunk (perceptual intent) right after IHDR: colour maps */
+} fs_image_tag;
+
+/* fs_image_write with a colour-space tag. For PNG, FS_IMAGE_SRGB inserts an sRGB chunk after
+ * IHDR (fs_image_write writes untagged PNGs, which is FS_IMAGE_UNTAGGED); other formats ignore the
+ * tag. Returns 0 or -1 with fs_error(FS_ERR_IO). */
+int fs_image_write_tagged(const char *path, const fs_image *img, fs_image_tag tag);
+
 typedef struct {
     double psnr;      /* dB over all channels, +inf when identical */
     double ssim;      /* mean SSIM over channels (Gaussian 11x11, sigma 1.5) */

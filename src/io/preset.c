@@ -23,6 +23,7 @@ _Static_assert(sizeof(fs_lattice) == sizeof(int), "enum fs_lattice is int-sized"
 _Static_assert(sizeof(fs_growth_type) == sizeof(int), "enum fs_growth_type is int-sized");
 _Static_assert(sizeof(fs_fracture_method) == sizeof(int), "enum fs_fracture_method is int-sized");
 _Static_assert(sizeof(fs_normal_convention) == sizeof(int), "enum fs_normal_convention is int-sized");
+_Static_assert(sizeof(fs_solver_method) == sizeof(int), "enum fs_solver_method is int-sized");
 _Static_assert(_Generic((int32_t)0, int: 1, default: 0), "int32_t is int");
 
 typedef enum {
@@ -36,7 +37,7 @@ typedef enum {
     KEY_INT,       /* int within the bounds */
     KEY_SEED,      /* uint64_t */
     KEY_PWL,       /* fs_pwl as "t:v, t:v, ..." or "none" */
-    KEY_SIZE,      /* render.width and render.height as WxH */
+    KEY_SIZE,      /* render.width and render.height (or the preview's) as WxH */
     KEY_COLOR,     /* float[3] linear light, written as sRGB #rrggbb */
     KEY_PERIODIC   /* domain.periodic_x and periodic_y as none|x|y|xy */
 } key_kind;
@@ -56,7 +57,8 @@ typedef struct {
 } key_def;
 
 static const char *const section_names[] = {"preset", "domain", "mesh", "material", "growth",
-                                            "shrink", "fracture", "time", "render", "voronoi", NULL};
+                                            "shrink", "fracture", "time", "render", "voronoi", "solver",
+                                            "wedge", "springs", NULL};
 static const char *const model_words[] = {"voronoi", "springs", "wedge", "shell", "tet", NULL};
 static const char *const domain_words[] = {"plane", "cylinder", "sphere", NULL};
 static const char *const periodic_words[] = {"none", "x", "y", "xy", NULL};
@@ -64,6 +66,8 @@ static const char *const lattice_words[] = {"random", "hex", NULL};
 static const char *const growth_words[] = {"none", "planar", "cylinder", "sphere", NULL};
 static const char *const method_words[] = {"split", "remove", NULL};
 static const char *const normal_words[] = {"opengl", "directx", NULL};
+static const char *const solver_words[] = {"cholmod", "cg", NULL};
+static const char *const post_words[] = {"glue", "curl", "flat", NULL};
 
 #define OFF(field) offsetof(fs_config, field)
 
@@ -114,6 +118,7 @@ static const key_def key_table[] = {
     {"time", "min_step", KEY_REAL, OFF(time.min_step), 0, 0, GT, NULL, NULL},
 
     {"render", "size", KEY_SIZE, 0, 16, 16384, GE | LE, NULL, NULL},
+    {"render", "preview_size", KEY_SIZE, OFF(render.preview_width), 16, 16384, GE | LE, NULL, NULL},
     {"render", "height_scale", KEY_REAL, OFF(render.height_scale), 0, 0, GT, NULL, NULL},
     {"render", "supersample", KEY_INT, OFF(render.supersample), 1, 8, GE | LE, NULL, NULL},
     {"render", "normal", KEY_WORD, OFF(render.normal), 0, 0, 0, normal_words, NULL},
@@ -121,6 +126,7 @@ static const key_def key_table[] = {
     {"render", "color_crack", KEY_COLOR, OFF(render.color_crack), 0, 0, 0, NULL, NULL},
     {"render", "color_background", KEY_COLOR, OFF(render.color_background), 0, 0, 0, NULL, NULL},
     {"render", "color_variation", KEY_REAL, OFF(render.color_variation), 0, 1, GE | LE, NULL, NULL},
+    {"render", "roughness", KEY_REAL, OFF(render.roughness), 0, 1, GE | LE, NULL, NULL},
 
     {"voronoi", "crack_width", KEY_REAL, OFF(voronoi.crack_width), 0, 0, GE, NULL, "cm"},
     {"voronoi", "bevel", KEY_REAL, OFF(voronoi.bevel), 0, 0, GE, NULL, "cm"},
@@ -128,6 +134,20 @@ static const key_def key_table[] = {
     {"voronoi", "warp", KEY_REAL, OFF(voronoi.warp), 0, 0, GE, NULL, "cm"},
     {"voronoi", "warp_scale", KEY_REAL, OFF(voronoi.warp_scale), 0, 0, GT, NULL, "cm"},
     {"voronoi", "subdivisions", KEY_INT, OFF(voronoi.subdivisions), 1, 64, GE | LE, NULL, NULL},
+
+    {"solver", "method", KEY_WORD, OFF(solver.method), 0, 0, 0, solver_words, NULL},
+    {"solver", "tolerance", KEY_REAL, OFF(solver.tolerance), 0, 0.1, GT | LE, NULL, NULL},
+    {"solver", "max_iterations", KEY_INT, OFF(solver.max_iterations), 0, 1000000000, GE | LE, NULL, NULL},
+
+    {"wedge", "thickness_gradient", KEY_REAL, OFF(wedge.thickness_gradient), -1.9, 1.9, GE | LE, NULL, NULL},
+
+    {"springs", "layers", KEY_INT, OFF(springs.layers), 1, 8, GE | LE, NULL, NULL},
+    {"springs", "shear_lag", KEY_REAL, OFF(springs.shear_lag), 0, 1e6, GT | LE, NULL, NULL},
+    {"springs", "slide_length", KEY_REAL_NONE, OFF(springs.slide_length), 0, 0, GT, NULL, "cm"},
+    {"springs", "residual", KEY_REAL, OFF(springs.residual), 0, 0.01, GT | LE, NULL, NULL},
+    {"springs", "max_breaks", KEY_INT, OFF(springs.max_breaks), 0, 2000000000, GE | LE, NULL, NULL},
+    {"springs", "post", KEY_WORD, OFF(springs.post), 0, 0, 0, post_words, NULL},
+    {"springs", "peel", KEY_REAL, OFF(springs.peel), 0, 0, GE, NULL, "cm"},
 };
 
 #define N_KEYS ((int)(sizeof key_table / sizeof key_table[0]))
@@ -551,8 +571,13 @@ static int apply_value(fs_config *cfg, const key_def *k, const char *value, cons
             snprintf(why, why_size, "WIDTHxHEIGHT in pixels, each in 16..16384");
             return -1;
         }
-        cfg->render.width = w;
-        cfg->render.height = h;
+        if (k->offset == OFF(render.preview_width)) {
+            cfg->render.preview_width = w;
+            cfg->render.preview_height = h;
+        } else {
+            cfg->render.width = w;
+            cfg->render.height = h;
+        }
         return 0;
     }
     case KEY_COLOR: {
@@ -639,7 +664,10 @@ static void format_value(const fs_config *cfg, const key_def *k, char *buf, size
         return;
     }
     case KEY_SIZE:
-        snprintf(buf, size, "%dx%d", cfg->render.width, cfg->render.height);
+        if (k->offset == OFF(render.preview_width))
+            snprintf(buf, size, "%dx%d", cfg->render.preview_width, cfg->render.preview_height);
+        else
+            snprintf(buf, size, "%dx%d", cfg->render.width, cfg->render.height);
         return;
     case KEY_COLOR: {
         const float *rgb = (const float *)field;

@@ -48,7 +48,16 @@ static json_t *map_entry(const fs_sidecar_map *m, const fs_config *cfg, const fs
     fs_domain_normalize(&d);
     json_t *e = json_object();
     json_object_set_new(e, "file", json_string(m->file));
+    if (m->usage)
+        json_object_set_new(e, "usage", json_string(m->usage));
+    if (m->channels)
+        json_object_set_new(e, "channels_meaning", json_string(m->channels));
+    if (!m->image)
+        return e;
     json_object_set_new(e, "color_space", json_string(m->color_space));
+    if (m->image->type != FS_PIX_F32)
+        json_object_set_new(e, "png_color_chunk",
+                            json_string(!strcmp(m->color_space, "srgb") ? "sRGB" : "none (raw values)"));
     json_object_set_new(e, "bit_depth", json_integer(bit_depth(m->image)));
     json_object_set_new(e, "sample_format", json_string(m->image->type == FS_PIX_F32 ? "float" : "unsigned"));
     json_object_set_new(e, "channels", json_integer(m->image->channels));
@@ -75,12 +84,15 @@ static json_t *map_entry(const fs_sidecar_map *m, const fs_config *cfg, const fs
         json_object_set_new(e, "encoding", json_string("fragment id, 0 = crack"));
     } else if (!strcmp(m->kind, "crackmask")) {
         json_object_set_new(e, "encoding", json_string("crack coverage, 255 = crack"));
+    } else if (!strcmp(m->kind, "occlusion") || !strcmp(m->kind, "roughness")) {
+        json_object_set_new(e, "roughness", json_real(cfg->render.roughness));
     }
     return e;
 }
 
 int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_text, const fs_stats *stats,
-                     const fs_maps *maps, const fs_sidecar_map *list, int n_maps, double wall_seconds)
+                     const fs_maps *maps, const char *target, const fs_sidecar_map *list, int n_maps,
+                     double wall_seconds)
 {
     json_t *root = json_object();
     json_object_set_new(root, "generator", json_string("fissure"));
@@ -108,6 +120,7 @@ int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_
     json_object_set_new(st, "wall_seconds", json_real(wall_seconds));
     json_object_set_new(root, "stats", st);
 
+    json_object_set_new(root, "target", json_string(target));
     json_t *jm = json_object();
     for (int i = 0; i < n_maps; i++)
         json_object_set_new(jm, list[i].kind, map_entry(&list[i], cfg, maps));

@@ -12,14 +12,18 @@
 typedef struct {
     const char *kind;        /* "height", "normal", ... */
     const char *file;        /* file name (no directory) */
-    const fs_image *image;
+    const fs_image *image;   /* NULL for a file that is not an image (the crack graph) */
     const char *color_space; /* "linear", "srgb", "data" */
+    const char *channels;    /* what each channel holds (NULL: not described) */
+    const char *usage;       /* where the target engine takes the file (NULL: no engine) */
 } fs_sidecar_map;
 
 /* Writes the sidecar to path: version, preset name and hash, seed, every resolved parameter,
- * statistics, and per map its colour space, bit depth, channels, normal convention, height scale
- * and tileability. preset_text is the preset file's content (hashed), or NULL. Returns 0 or -1. */
+ * statistics, the engine target (--target) and per file its colour space, bit depth, channels and
+ * their meaning, engine usage, normal convention, height scale and tileability. preset_text is the
+ * preset file's content (hashed), or NULL. Returns 0 or -1. */
 int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_text, const fs_stats *stats,
-                     const fs_maps *maps, const fs_sidecar_map *list, int n_maps, double wall_seconds);
+                     const fs_maps *maps, const char *target, const fs_sidecar_map *list, int n_maps,
+                     double wall_seconds);
 
 #endif

@@ -99,14 +99,15 @@ static int neighbours(int i, int n, bool wrap, int *lo, int *hi)
 
 /* design: tangent-space normal of the height field z = s * h(u, v) (s = height_scale), with the
  * gradient from central differences in cm per cm: n = normalize(-s dh/du, -s dh/dv, 1), where
- * +v points to the top of the image (render.h). OpenGL maps store n.y in green; DirectX stores -n.y.
+ * +v points to the top of the image (render.h). OpenGL maps store n.y in green; DirectX stores -n.y
+ * as the bitwise inverse 255 - g of the OpenGL byte, so the two maps differ exactly by a green flip.
  * A surface rising towards the top of the image faces down (-v), so its OpenGL green is below 128. */
 static void build_normal(const fs_raster *r, const fs_render_params *p, bool wrap_u, bool wrap_v, double cm_u,
                          double cm_v, fs_image *img)
 {
     const int w = r->width, h = r->height;
     const double s = p->height_scale;
-    const double green_sign = p->normal == FS_NORMAL_DIRECTX ? -1.0 : 1.0;
+    const bool directx = p->normal == FS_NORMAL_DIRECTX;
     uint8_t *px = img->data;
     for (int j = 0; j < h; j++) {
         int up, down;
@@ -129,7 +130,9 @@ static void build_normal(const fs_raster *r, const fs_render_params *p, bool wra
             nz /= len;
             uint8_t *o = px + 3 * ((size_t)j * w + i);
             o[0] = unit_to_u8(nx * 0.5 + 0.5);
-            o[1] = unit_to_u8(green_sign * ny * 0.5 + 0.5);
+            o[1] = unit_to_u8(ny * 0.5 + 0.5);
+            if (directx)
+                o[1] = (uint8_t)(255 - o[1]);
             o[2] = unit_to_u8(nz * 0.5 + 0.5);
         }
     }

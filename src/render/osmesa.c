@@ -1,12 +1,14 @@
 /* Off-screen float rendering through OSMesa (gallium llvmpipe): the only file that includes OSMesa. */
 #include "render/osmesa.h"
 
+#define GL_GLEXT_PROTOTYPES 1
 #include <GL/osmesa.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
 
 #include <stdbool.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "base/error.h"
 
@@ -23,12 +25,15 @@
  * exactly), so triangles reaching out of a tile by less than the margin are never clipped, and the
  * window -> clip -> window round trip is exact for coordinates on a 1/256-sample grid. */
 
+typedef struct lit_state lit_state;
+
 struct fs_osmesa {
     OSMesaContext ctx;
     int width, height;
     int viewport;  /* side of the square viewport (a power of two) */
     int margin;    /* viewport extends this many samples beyond the buffer on the left and bottom */
     float *buffer; /* width * height RGBA, rows bottom to top */
+    lit_state *lit; /* the lit pass, once loaded */
 };
 
 /* Depth bits asked for; llvmpipe gives 24 (Z24), which resolves height differences of 2^-24 of the
@@ -124,6 +129,7 @@ void fs_osmesa_destroy(fs_osmesa *g)
 {
     if (!g)
         return;
+    fs_osmesa_lit_unload(g);
     if (g->ctx) {
         if (OSMesaGetCurrentContext() == g->ctx)
             OSMesaMakeCurrent(NULL, NULL, 0, 0, 0);
@@ -167,4 +173,417 @@ const float *fs_osmesa_finish(fs_osmesa *g)
     if (gl_check("finishing") != 0)
         return NULL;
     return g->buffer;
+}
+
+/* ---- the lit pass ---- */
+
+/* Samples per pixel of the multisampled target (llvmpipe offers 4). */
+static const int lit_samples = 4;
+
+enum { ATTR_POS, ATTR_NORMAL, ATTR_UV, ATTR_TINT, ATTR_TANGENT, ATTR_INDEX, N_BUFFERS };
+#define N_ATTRS 5
+
+struct lit_state {
+    GLuint program, depth_program;
+    GLuint vao;
+    int n_meshes;
+    GLuint *buffers;   /* N_BUFFERS per mesh */
+    GLsizei *counts;   /* indices per mesh */
+    GLuint texture, normal_texture;
+    float normal_green_sign;
+    GLuint shadow_tex, shadow_fbo;
+    GLuint msaa_fbo, msaa_color, msaa_depth;
+    fs_osmesa_scene scene;
+};
+
+static const char *const lit_vertex_source =
+    "#version 330\n"
+    "layout(location = 0) in vec3 a_pos;\n"
+    "layout(location = 1) in vec3 a_normal;\n"
+    "layout(location = 2) in vec2 a_uv;\n"
+    "layout(location = 3) in vec4 a_tint;\n"
+    "layout(location = 4) in vec3 a_tu;\n"
+    "layout(location = 5) in vec3 a_tv;\n"
+    "uniform mat4 u_clip_from_world;\n"
+    "out vec3 v_pos;\n"
+    "out vec3 v_normal;\n"
+    "out vec2 v_uv;\n"
+    "out vec4 v_tint;\n"
+    "out vec3 v_tu;\n"
+    "out vec3 v_tv;\n"
+    "void main() {\n"
+    "    v_pos = a_pos;\n"
+    "    v_normal = a_normal;\n"
+    "    v_uv = a_uv;\n"
+    "    v_tint = a_tint;\n"
+    "    v_tu = a_tu;\n"
+    "    v_tv = a_tv;\n"
+    "    gl_Position = u_clip_from_world * vec4(a_pos, 1.0);\n"
+    "}\n";
+
+static const char *const lit_fragment_source =
+    "#version 330\n"
+    "in vec3 v_pos;\n"
+    "in vec3 v_normal;\n"
+    "in vec2 v_uv;\n"
+    "in vec4 v_tint;\n"
+    "in vec3 v_tu;\n"
+    "in vec3 v_tv;\n"
+    "uniform sampler2D u_color;\n"
+    "uniform sampler2D u_normal_map;\n"
+    "uniform float u_green_sign;\n"
+    "uniform sampler2DShadow u_shadow;\n"
+    "uniform mat4 u_shadow_from_world;\n"
+    "uniform int u_use_shadow;\n"
+    "uniform float u_shadow_texel, u_shadow_offset, u_specular, u_shininess;\n"
+    "uniform vec3 u_eye, u_light_dir, u_light_rgb, u_sky_rgb, u_ground_rgb, u_up;\n"
+    "out vec4 o_color;\n"
+    "void main() {\n"
+    "    vec3 n = normalize(v_normal);\n"
+    "    vec3 view = normalize(u_eye - v_pos);\n"
+    "    float facing = dot(n, view) < 0.0 ? -1.0 : 1.0;\n"
+    "    if (v_tint.a > 0.0) {\n"
+    "        vec3 m = texture(u_normal_map, v_uv).rgb * 2.0 - 1.0;\n"
+    "        vec3 tu = normalize(v_tu), tv = normalize(v_tv), tn = normalize(cross(tu, tv));\n"
+    "        vec3 mapped = normalize(tu * m.x + tv * (m.y * u_green_sign) + tn * m.z);\n"
+    "        n = normalize(mix(n, mapped, v_tint.a));\n"
+    "    }\n"
+    "    n *= facing;\n"
+    "    vec3 albedo = mix(v_tint.rgb, texture(u_color, v_uv).rgb, v_tint.a);\n"
+    "    float lit = 1.0;\n"
+    "    if (u_use_shadow != 0) {\n"
+    "        vec4 s = u_shadow_from_world * vec4(v_pos + n * u_shadow_offset, 1.0);\n"
+    "        vec3 t = s.xyz / s.w * 0.5 + 0.5;\n"
+    "        lit = 0.0;\n"
+    "        for (int j = -1; j <= 1; j++)\n"
+    "            for (int i = -1; i <= 1; i++)\n"
+    "                lit += texture(u_shadow, vec3(t.xy + vec2(i, j) * u_shadow_texel, t.z));\n"
+    "        lit /= 9.0;\n"
+    "    }\n"
+    "    float diffuse = max(dot(n, u_light_dir), 0.0);\n"
+    "    vec3 h = normalize(u_light_dir + view);\n"
+    "    float spec = diffuse > 0.0 ? u_specular * pow(max(dot(n, h), 0.0), u_shininess) : 0.0;\n"
+    "    vec3 ambient = mix(u_ground_rgb, u_sky_rgb, 0.5 + 0.5 * dot(n, u_up));\n"
+    "    vec3 c = albedo * (ambient + u_light_rgb * diffuse * lit) + u_light_rgb * spec * lit;\n"
+    "    o_color = vec4(c, 1.0);\n"
+    "}\n";
+
+static const char *const depth_vertex_source =
+    "#version 330\n"
+    "layout(location = 0) in vec3 a_pos;\n"
+    "uniform mat4 u_clip_from_world;\n"
+    "void main() { gl_Position = u_clip_from_world * vec4(a_pos, 1.0); }\n";
+
+static const char *const depth_fragment_source =
+    "#version 330\n"
+    "void main() { }\n";
+
+static GLuint compile(GLenum type, const char *source, const char *what)
+{
+    GLuint sh = glCreateShader(type);
+    glShaderSource(sh, 1, &source, NULL);
+    glCompileShader(sh);
+    GLint ok = 0;
+    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[512] = "";
+        glGetShaderInfoLog(sh, sizeof log, NULL, log);
+        fs_error(FS_ERR_INTERNAL, "osmesa: the %s shader does not compile: %s", what, log);
+        glDeleteShader(sh);
+        return 0;
+    }
+    return sh;
+}
+
+static GLuint link_program(const char *vs_source, const char *fs_source, const char *what)
+{
+    GLuint vs = compile(GL_VERTEX_SHADER, vs_source, what);
+    GLuint fs = vs ? compile(GL_FRAGMENT_SHADER, fs_source, what) : 0;
+    if (!fs) {
+        if (vs)
+            glDeleteShader(vs);
+        return 0;
+    }
+    GLuint prog = glCreateProgram();
+    glAttachShader(prog, vs);
+    glAttachShader(prog, fs);
+    glLinkProgram(prog);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[512] = "";
+        glGetProgramInfoLog(prog, sizeof log, NULL, log);
+        fs_error(FS_ERR_INTERNAL, "osmesa: the %s program does not link: %s", what, log);
+        glDeleteProgram(prog);
+        return 0;
+    }
+    return prog;
+}
+
+static void set_vec3(GLuint prog, const char *name, const float *v)
+{
+    glUniform3f(glGetUniformLocation(prog, name), v[0], v[1], v[2]);
+}
+
+/* Puts the raster pass's state back: no program, buffers, framebuffer or vertex array bound, and
+ * its viewport. */
+static void restore_raster_state(fs_osmesa *g)
+{
+    glUseProgram(0);
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisable(GL_MULTISAMPLE);
+    glViewport(-g->margin, -g->margin, g->viewport, g->viewport);
+}
+
+static void draw_meshes(const lit_state *L)
+{
+    glBindVertexArray(L->vao);
+    for (int k = 0; k < L->n_meshes; k++) {
+        if (L->counts[k] == 0)
+            continue;
+        const GLuint *b = L->buffers + N_BUFFERS * k;
+        static const GLint sizes[N_ATTRS] = {3, 3, 2, 4, 3};
+        for (int a = 0; a < N_ATTRS; a++) {
+            glBindBuffer(GL_ARRAY_BUFFER, b[a]);
+            glVertexAttribPointer((GLuint)a, sizes[a], GL_FLOAT, GL_FALSE, a == ATTR_TANGENT ? 6 * sizeof(float) : 0,
+                                  NULL);
+            glEnableVertexAttribArray((GLuint)a);
+        }
+        /* the v direction follows the u direction in each tangent record */
+        glVertexAttribPointer(N_ATTRS, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), (const void *)(3 * sizeof(float)));
+        glEnableVertexAttribArray(N_ATTRS);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, b[ATTR_INDEX]);
+        glDrawElements(GL_TRIANGLES, L->counts[k], GL_UNSIGNED_INT, NULL);
+    }
+}
+
+/* Uploads an RGB image with rows bottom to top, so that texture v goes up the image, mipmapped. */
+static GLuint upload_rgb(int width, int height, const uint8_t *rgb, GLenum internal, bool wrap_u, bool wrap_v)
+{
+    GLuint t;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    size_t row = 3 * (size_t)width;
+    uint8_t *flipped = fs_malloc(row * (size_t)height);
+    for (int j = 0; j < height; j++)
+        memcpy(flipped + row * (size_t)j, rgb + row * (size_t)(height - 1 - j), row);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, (GLint)internal, width, height, 0, GL_RGB, GL_UNSIGNED_BYTE, flipped);
+    free(flipped);
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap_u ? GL_REPEAT : GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap_v ? GL_REPEAT : GL_CLAMP_TO_EDGE);
+    glTexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY_EXT, 8.0f);
+    return t;
+}
+
+static int make_targets(fs_osmesa *g, lit_state *L)
+{
+    glGenFramebuffers(1, &L->msaa_fbo);
+    glGenRenderbuffers(1, &L->msaa_color);
+    glGenRenderbuffers(1, &L->msaa_depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, L->msaa_color);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, lit_samples, GL_RGBA32F, g->width, g->height);
+    glBindRenderbuffer(GL_RENDERBUFFER, L->msaa_depth);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, lit_samples, GL_DEPTH_COMPONENT24, g->width, g->height);
+    glBindFramebuffer(GL_FRAMEBUFFER, L->msaa_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, L->msaa_color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, L->msaa_depth);
+    GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+        fs_error(FS_ERR_INTERNAL, "osmesa: cannot make a %d x %d multisampled float target (status 0x%04x)", g->width,
+                 g->height, (unsigned)status);
+        return -1;
+    }
+    int size = L->scene.shadow_size;
+    if (size <= 0)
+        return 0;
+    glGenTextures(1, &L->shadow_tex);
+    glBindTexture(GL_TEXTURE_2D, L->shadow_tex);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, size, size, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    static const float far_border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+    glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, far_border);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glGenFramebuffers(1, &L->shadow_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, L->shadow_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, L->shadow_tex, 0);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+        fs_error(FS_ERR_INTERNAL, "osmesa: cannot make a %d x %d shadow map (status 0x%04x)", size, size,
+                 (unsigned)status);
+        return -1;
+    }
+    return 0;
+}
+
+/* Renders the depth of the scene seen from the light into the shadow map; slope-scaled polygon
+ * offset keeps lit surfaces from shadowing themselves. */
+static void render_shadow(lit_state *L)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, L->shadow_fbo);
+    glViewport(0, 0, L->scene.shadow_size, L->scene.shadow_size);
+    glClearDepth(1.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.5f, 2.0f);
+    glUseProgram(L->depth_program);
+    glUniformMatrix4fv(glGetUniformLocation(L->depth_program, "u_clip_from_world"), 1, GL_FALSE,
+                       L->scene.shadow_from_world);
+    draw_meshes(L);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+}
+
+int fs_osmesa_lit_load(fs_osmesa *g, const fs_osmesa_scene *s, const fs_osmesa_mesh *meshes, int n_meshes,
+                       const fs_osmesa_texture *tex)
+{
+    fs_osmesa_lit_unload(g);
+    lit_state *L = fs_calloc(1, sizeof *L);
+    g->lit = L;
+    L->scene = *s;
+    L->program = link_program(lit_vertex_source, lit_fragment_source, "lit");
+    L->depth_program = L->program ? link_program(depth_vertex_source, depth_fragment_source, "shadow") : 0;
+    if (!L->depth_program || gl_check("compiling the lit pass") != 0)
+        goto fail;
+    glGenVertexArrays(1, &L->vao);
+    L->n_meshes = n_meshes;
+    L->buffers = fs_calloc((size_t)N_BUFFERS * (size_t)(n_meshes > 0 ? n_meshes : 1), sizeof *L->buffers);
+    L->counts = fs_calloc((size_t)(n_meshes > 0 ? n_meshes : 1), sizeof *L->counts);
+    for (int k = 0; k < n_meshes; k++) {
+        const fs_osmesa_mesh *m = meshes + k;
+        GLuint *b = L->buffers + N_BUFFERS * k;
+        glGenBuffers(N_BUFFERS, b);
+        const float *data[N_ATTRS] = {m->pos, m->normal, m->uv, m->tint, m->tangent};
+        static const size_t sizes[N_ATTRS] = {3, 3, 2, 4, 6};
+        for (int a = 0; a < N_ATTRS; a++) {
+            glBindBuffer(GL_ARRAY_BUFFER, b[a]);
+            glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizes[a] * (size_t)m->n_verts * sizeof(float)), data[a],
+                         GL_STATIC_DRAW);
+        }
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, b[ATTR_INDEX]);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(3 * (size_t)m->n_tris * sizeof(uint32_t)), m->tri,
+                     GL_STATIC_DRAW);
+        L->counts[k] = 3 * (GLsizei)m->n_tris;
+    }
+    L->texture = upload_rgb(tex->width, tex->height, tex->rgb, GL_SRGB8, tex->wrap_u, tex->wrap_v);
+    L->normal_texture = upload_rgb(tex->normal_width, tex->normal_height, tex->normal, GL_RGB8, tex->wrap_u, tex->wrap_v);
+    L->normal_green_sign = tex->normal_green_sign;
+    if (gl_check("uploading the lit scene") != 0 || make_targets(g, L) != 0)
+        goto fail;
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    if (L->scene.shadow_size > 0)
+        render_shadow(L);
+    int rc = gl_check("rendering the shadow map");
+    restore_raster_state(g);
+    if (rc != 0)
+        goto fail;
+    return 0;
+
+fail:
+    restore_raster_state(g);
+    fs_osmesa_lit_unload(g);
+    return -1;
+}
+
+int fs_osmesa_lit_draw(fs_osmesa *g, const float clip_from_world[16])
+{
+    lit_state *L = g->lit;
+    FS_ASSERT(L);
+    const fs_osmesa_scene *s = &L->scene;
+    glBindFramebuffer(GL_FRAMEBUFFER, L->msaa_fbo);
+    glViewport(0, 0, g->width, g->height);
+    glEnable(GL_MULTISAMPLE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    GLuint p = L->program;
+    glUseProgram(p);
+    glUniformMatrix4fv(glGetUniformLocation(p, "u_clip_from_world"), 1, GL_FALSE, clip_from_world);
+    glUniformMatrix4fv(glGetUniformLocation(p, "u_shadow_from_world"), 1, GL_FALSE, s->shadow_from_world);
+    glUniform1i(glGetUniformLocation(p, "u_use_shadow"), s->shadow_size > 0);
+    glUniform1f(glGetUniformLocation(p, "u_shadow_texel"), s->shadow_size > 0 ? 1.0f / (float)s->shadow_size : 0.0f);
+    glUniform1f(glGetUniformLocation(p, "u_shadow_offset"), s->shadow_offset);
+    glUniform1f(glGetUniformLocation(p, "u_specular"), s->specular);
+    glUniform1f(glGetUniformLocation(p, "u_shininess"), s->shininess);
+    set_vec3(p, "u_eye", s->eye);
+    set_vec3(p, "u_light_dir", s->light_dir);
+    set_vec3(p, "u_light_rgb", s->light_rgb);
+    set_vec3(p, "u_sky_rgb", s->sky_rgb);
+    set_vec3(p, "u_ground_rgb", s->ground_rgb);
+    set_vec3(p, "u_up", s->up);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, L->texture);
+    glUniform1i(glGetUniformLocation(p, "u_color"), 0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, L->shadow_tex);
+    glUniform1i(glGetUniformLocation(p, "u_shadow"), 1);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, L->normal_texture);
+    glUniform1i(glGetUniformLocation(p, "u_normal_map"), 2);
+    glUniform1f(glGetUniformLocation(p, "u_green_sign"), L->normal_green_sign);
+    draw_meshes(L);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, L->msaa_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glBlitFramebuffer(0, 0, g->width, g->height, 0, 0, g->width, g->height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    int rc = gl_check("drawing the lit scene");
+    restore_raster_state(g);
+    return rc;
+}
+
+void fs_osmesa_lit_unload(fs_osmesa *g)
+{
+    lit_state *L = g ? g->lit : NULL;
+    if (!L)
+        return;
+    if (L->buffers) {
+        for (int k = 0; k < L->n_meshes; k++)
+            glDeleteBuffers(N_BUFFERS, L->buffers + N_BUFFERS * k);
+    }
+    if (L->vao)
+        glDeleteVertexArrays(1, &L->vao);
+    if (L->texture)
+        glDeleteTextures(1, &L->texture);
+    if (L->normal_texture)
+        glDeleteTextures(1, &L->normal_texture);
+    if (L->shadow_tex)
+        glDeleteTextures(1, &L->shadow_tex);
+    if (L->shadow_fbo)
+        glDeleteFramebuffers(1, &L->shadow_fbo);
+    if (L->msaa_fbo)
+        glDeleteFramebuffers(1, &L->msaa_fbo);
+    if (L->msaa_color)
+        glDeleteRenderbuffers(1, &L->msaa_color);
+    if (L->msaa_depth)
+        glDeleteRenderbuffers(1, &L->msaa_depth);
+    if (L->program)
+        glDeleteProgram(L->program);
+    if (L->depth_program)
+        glDeleteProgram(L->depth_program);
+    free(L->buffers);
+    free(L->counts);
+    free(L);
+    g->lit = NULL;
 }

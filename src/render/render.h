@@ -5,6 +5,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "geom/domain.h"
 #include "io/image.h"
 
 typedef enum { FS_NORMAL_OPENGL = 0, FS_NORMAL_DIRECTX = 1 } fs_normal_convention;
@@ -12,15 +13,17 @@ typedef enum { FS_NORMAL_OPENGL = 0, FS_NORMAL_DIRECTX = 1 } fs_normal_conventio
 typedef struct {
     int width, height;          /* map size in pixels */
     int supersample;            /* samples per pixel along each axis for anti-aliasing (1..8) */
+    int preview_width, preview_height; /* size of the lit 3-D preview image in pixels */
     double height_scale;        /* exaggeration of height for the normal map */
     fs_normal_convention normal;
     float color_material[3];    /* linear-light RGB of the material top */
     float color_crack[3];       /* crack walls */
     float color_background[3];  /* exposed background at the bottom of cracks */
     double color_variation;     /* per-cell variation of the material colour, [0, 1] */
+    double roughness;           /* PBR roughness of the surface, [0, 1], for the packed engine maps */
 } fs_render_params;
 
-/* 1024 x 1024, supersample 4, height scale 1, OpenGL normals, a warm clay palette. */
+/* 1024 x 1024, supersample 4, 1024 x 768 preview, height scale 1, OpenGL normals, a warm clay palette. */
 fs_render_params fs_render_params_default(void);
 
 /* A triangle mesh in texture space with per-vertex attributes; what every model hands the renderer.
@@ -92,5 +95,59 @@ typedef struct {
 int fs_maps_build(const fs_raster *r, const fs_render_params *p, bool wrap_u, bool wrap_v,
                   double cm_per_pixel_u, double cm_per_pixel_v, fs_maps *out);
 void fs_maps_free(fs_maps *m);
+
+/* A render mesh lifted into 3-D (render/lift.c): what NAME.obj holds and the preview draws.
+ * Indices follow Wavefront OBJ: each triangle corner names a position, a texture vertex and a
+ * normal separately, so a position on a seam (u = 0 and u = 1 on the cylinder and sphere, the
+ * poles) is one vertex with several texture coordinates. */
+typedef struct {
+    int32_t n_pos;
+    double *pos;         /* 3 per position, world cm; no two closer than weld_tolerance */
+    int32_t n_uv;
+    float *uv;           /* 2 per texture vertex, in [0, 1]; v is the maps' v (up the image) */
+    int32_t n_normal;
+    float *normal;       /* 3 per unit normal */
+    int32_t n_tris;
+    int32_t *corner;     /* 9 per triangle: (position, uv, normal) of each corner, counter-clockwise
+                          * seen from outside (above the layer) */
+    uint8_t *wall;       /* per triangle: 1 for a wall the lift added to close a step, else 0 */
+    double weld_tolerance; /* cm */
+} fs_lifted_mesh;
+
+/* design: each triangle of m is clipped to the texture square (on wrapping axes the pieces outside
+ * are shifted back by a period, so every point of the layer appears once with uv in [0, 1]) and
+ * each vertex is placed at the domain point of its uv (fs_domain_from_uv, fs_domain_embed), moved
+ * by height * height_scale along the outward normal: plane (u W, v H, h), cylinder and sphere at
+ * radius R + h. Positions closer than 2.5e-7 of the domain's size are welded (so the cylinder and
+ * sphere close across their seam and at the poles); triangles that collapse are dropped; each is
+ * oriented by its area in texture space (walls with no such area take the orientation of their
+ * neighbours). The render mesh draws a step between two surfaces (a crack floor beside a cell top)
+ * as two boundaries over the same line in texture space; the lift closes every such step by a
+ * vertical wall of two triangles, so the result is bounded only along the domain's borders:
+ * the four sides of a plane (periodic or not: a tile is a flat slab in 3-D), the two ends of a
+ * cylinder, nowhere on a sphere. Corner normals average, weighted by angle, the normals of the
+ * triangles around the position within 50 degrees of the corner's own triangle, so walls and
+ * tops keep a crisp edge. Returns 0, or -1 with fs_error(FS_ERR_INTERNAL) for a non-finite vertex. */
+int fs_render_mesh_lift(const fs_render_mesh *m, const fs_domain *d, double height_scale, fs_lifted_mesh *out);
+void fs_lifted_mesh_free(fs_lifted_mesh *l);
+
+/* Edges (pairs of position indices) used by exactly one triangle, in the direction their triangle
+ * runs along them: 2 * count entries in *edges (caller frees). Returns the count, or -1 with
+ * fs_error(FS_ERR_INTERNAL) when an edge has more than two triangles or two in the same
+ * direction (a non-manifold or inconsistently oriented mesh). */
+int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges);
+
+/* The corners of l as vertices for drawing: one per distinct (position, texture vertex, normal),
+ * *vert holding those three indices per vertex, and 3 vertex indices per triangle in *tri (caller
+ * frees both). Returns the number of vertices. */
+int32_t fs_lifted_mesh_vertices(const fs_lifted_mesh *l, int32_t **vert, uint32_t **tri);
+
+/* The lit perspective 3-D view of SPEC §6 (render/preview.c): the lifted render mesh (heights times
+ * p->height_scale) textured with maps->basecolor, shown as a slab for a plane, a trunk segment
+ * for a cylinder and a globe for a sphere, into a p->preview_width x p->preview_height RGB 8-bit
+ * sRGB image (allocated into *out). Deterministic for a given mesh on a given machine. Returns 0
+ * or -1 with fs_error. */
+int fs_render_preview(const fs_render_mesh *m, const fs_domain *d, const fs_render_params *p, const fs_maps *maps,
+                      fs_image *out);
 
 #endif

@@ -33,6 +33,13 @@ fs_config fs_config_default(void)
 
     c.render = fs_render_params_default();
     c.voronoi = fs_voronoi_params_default();
+    c.springs = fs_springs_params_default();
+
+    c.solver.method = FS_SOLVER_CHOLMOD;
+    c.solver.tolerance = 1e-8;
+    c.solver.max_iterations = 0;
+
+    c.wedge.thickness_gradient = 0.0;
     return c;
 }
 

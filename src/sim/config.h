@@ -7,6 +7,7 @@
 
 #include "field/field.h"
 #include "geom/domain.h"
+#include "model/springs.h"
 #include "model/voronoi.h"
 #include "render/render.h"
 
@@ -66,6 +67,7 @@ typedef struct {
     fs_time_params time;
     fs_render_params render;
     fs_voronoi_params voronoi;
+    fs_springs_params springs;
     fs_solver_params solver;
     fs_wedge_params wedge;
 } fs_config;

@@ -7,15 +7,19 @@
 #include "base/log.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
+#include "model/springs.h"
 #include "model/voronoi.h"
+#include "model/wedge.h"
 
 /* Points for the mesh: particle repulsion, or the hexagonal lattice. */
 static int sample_points(const fs_config *cfg, fs_points *pts)
 {
+    /* the wedge model counts triangles (wedges): a Delaunay mesh has about two per point */
+    int32_t count = cfg->preset.model == FS_MODEL_WEDGE ? cfg->mesh.elements / 2 : cfg->mesh.elements;
     if (cfg->mesh.lattice == FS_LATTICE_HEX)
-        return fs_sample_hex(&cfg->domain, cfg->mesh.elements, pts);
+        return fs_sample_hex(&cfg->domain, count, pts);
     fs_sample_params sp = fs_sample_params_default();
-    sp.count = cfg->mesh.elements;
+    sp.count = count;
     sp.iterations = cfg->mesh.relax_iterations;
     sp.radius_jitter = cfg->mesh.radius_jitter;
     sp.seed = cfg->preset.seed;
@@ -49,6 +53,14 @@ int fs_sim_run(const fs_config *cfg, fs_result *out)
         fs_progress("model", -1, "voronoi cells");
         rc = fs_voronoi_render_mesh(&out->mesh, &cfg->voronoi, cfg->preset.seed, &out->surface);
         break;
+    case FS_MODEL_SPRINGS:
+        rc = fs_springs_run(&out->mesh, &cfg->springs, &cfg->material, &cfg->growth, &cfg->shrink, cfg->time.end,
+                            cfg->time.min_step, cfg->preset.seed, &out->surface, &out->stats.fractures,
+                            &out->stats.simulated_time);
+        break;
+    case FS_MODEL_WEDGE:
+        rc = fs_wedge_run(cfg, &out->mesh, &out->surface, &out->stats);
+        break;
     default:
         fs_error(FS_ERR_DATA, "[preset] model: the %s model is not available in this build; expected voronoi",
                  fs_model_name(cfg->preset.model));
@@ -63,8 +75,6 @@ int fs_sim_run(const fs_config *cfg, fs_result *out)
     }
     out->stats.nodes = out->mesh.n_nodes;
     out->stats.elements = out->mesh.n_tris;
-    out->stats.fractures = 0;
-    out->stats.simulated_time = 0;
     out->stats.sample_seconds = t1 - t0;
     out->stats.mesh_seconds = t2 - t1;
     out->stats.model_seconds = t3 - t2;

@@ -1,0 +1,1367 @@
+/* The wedge model's layer: geometry and materials from the mesh, sparse assembly, equilibrium (CHOLMOD or CG) and element stresses. */
+#include "model/wedge.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "base/log.h"
+#include "base/rng.h"
+#include "base/vec.h"
+#include "fracture/eigen.h"
+#include "fracture/rank.h"
+#include "geom/refine.h"
+#include "io/image.h"
+#include "model/wedge_element.h"
+#include "solve/cg.h"
+
+/* Map factors are clamped to this floor so that a black pixel cannot make an element singular. */
+#define MAP_FLOOR 0.02
+
+/* ---- grey-level maps (thesis §5.9) ---- */
+
+typedef struct {
+    int width, height;
+    float *grey;
+    bool wrap_u, wrap_v;
+} grey_map;
+
+static int map_load(const char *path, const fs_domain *d, grey_map *m)
+{
+    memset(m, 0, sizeof *m);
+    if (!path[0])
+        return 0;
+    if (fs_image_read_grey(path, &m->width, &m->height, &m->grey) < 0)
+        return -1;
+    m->wrap_u = fs_domain_wraps_u(d);
+    m->wrap_v = fs_domain_wraps_v(d);
+    return 0;
+}
+
+static void map_free(grey_map *m)
+{
+    free(m->grey);
+    memset(m, 0, sizeof *m);
+}
+
+/* Pixel index along one axis: wrapped or clamped. */
+static int map_index(int i, int n, bool wrap)
+{
+    if (wrap) {
+        i %= n;
+        return i < 0 ? i + n : i;
+    }
+    return i < 0 ? 0 : i >= n ? n - 1 : i;
+}
+
+/* Bilinear grey value at texture coordinates (u, v), v up (render.h's pixel convention). */
+static double map_sample(const grey_map *m, double u, double v)
+{
+    double fx = u * m->width - 0.5, fy = (1.0 - v) * m->height - 0.5;
+    double x0 = floor(fx), y0 = floor(fy);
+    double ax = fx - x0, ay = fy - y0;
+    int i0 = map_index((int)x0, m->width, m->wrap_u), i1 = map_index((int)x0 + 1, m->width, m->wrap_u);
+    int j0 = map_index((int)y0, m->height, m->wrap_v), j1 = map_index((int)y0 + 1, m->height, m->wrap_v);
+    const float *g = m->grey;
+    double top = g[(size_t)j0 * m->width + i0] * (1.0 - ax) + g[(size_t)j0 * m->width + i1] * ax;
+    double bot = g[(size_t)j1 * m->width + i0] * (1.0 - ax) + g[(size_t)j1 * m->width + i1] * ax;
+    return top * (1.0 - ay) + bot * ay;
+}
+
+/* The map factor at a domain point (unwrapped coordinates are fine: the map wraps with the domain). */
+static double map_at(const grey_map *m, const fs_domain *d, const double *p)
+{
+    if (!m->grey)
+        return 1.0;
+    double uv[2];
+    fs_domain_to_uv(d, p, uv);
+    return fmax(map_sample(m, uv[0], uv[1]), MAP_FLOOR);
+}
+
+/* A map averaged over a triangle: its centroid and the three interior points (2/3, 1/6, 1/6). */
+static double map_average(const grey_map *m, const fs_domain *d, const double corner[3][3])
+{
+    if (!m->grey)
+        return 1.0;
+    static const double bary[4][3] = {
+        {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0}, {2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0},
+        {1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0}, {1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0}};
+    double sum = 0.0;
+    for (int q = 0; q < 4; q++) {
+        double p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = bary[q][0] * corner[0][k] + bary[q][1] * corner[1][k] + bary[q][2] * corner[2][k];
+        if (d->type == FS_DOMAIN_SPHERE) {
+            double r = fs_norm3(p);
+            for (int k = 0; k < 3; k++)
+                p[k] *= d->radius / r;
+        }
+        sum += map_at(m, d, p);
+    }
+    return sum / 4.0;
+}
+
+/* ---- geometry ---- */
+
+static double layer_thickness(const fs_wedge_model *w, double t)
+{
+    return fs_material_thickness(&w->cfg.material, t, w->cfg.time.end);
+}
+
+/* Nodal thickness factor: the thickness map at the node and the linear gradient across u. */
+static double node_thickness_factor(const fs_wedge_model *w, const grey_map *tmap, int32_t i)
+{
+    const fs_domain *d = &w->mesh->domain;
+    const double *p = w->mesh->pos + 3 * (size_t)i;
+    double uv[2];
+    fs_domain_to_uv(d, p, uv);
+    double f = 1.0 + w->cfg.wedge.thickness_gradient * (uv[0] - 0.5);
+    return fmax(f, MAP_FLOOR) * map_at(tmap, d, p);
+}
+
+static void node_normal(const fs_wedge_model *w, int32_t i, double n[3])
+{
+    if (w->flat) {
+        n[0] = n[1] = 0.0;
+        n[2] = 1.0;
+        return;
+    }
+    fs_domain_normal(&w->mesh->domain, w->mesh->pos + 3 * (size_t)i, n);
+}
+
+static void coords_at(const fs_wedge_model *w, int32_t e, double base_thickness, double x[18])
+{
+    const fs_mesh *m = w->mesh;
+    for (int c = 0; c < 3; c++) {
+        int32_t node = m->tri[3 * (size_t)e + c];
+        double *b = x + 3 * c, *t = x + 3 * (c + 3);
+        fs_mesh_corner(m, e, c, b);
+        if (w->flat)
+            b[2] = 0.0;
+        double h = base_thickness * w->thickness_factor[node];
+        const double *n = w->normal + 3 * (size_t)node;
+        for (int k = 0; k < 3; k++)
+            t[k] = b[k] + h * n[k];
+    }
+}
+
+void fs_wedge_element_coords(const fs_wedge_model *w, int32_t e, double x[18])
+{
+    coords_at(w, e, w->assembled_thickness, x);
+}
+
+/* design: the unit displacement patterns of an element whose combinations give its loads.
+ *   0..2  shrinkage (thesis Fig. 3.10, see wedge.h): bottom nodes about the bottom centroid, top nodes
+ *         about the top centroid, and the top lifted along the centroid-to-centroid vector; the
+ *         reference-shape displacement is sum_k (scale_k - 1) pattern_k.
+ *   3..5  the linear displacements with unit strain xx, yy and engineering xy (about the element's
+ *         centroid). An isoparametric element reproduces linear fields exactly, so K_e times such a
+ *         pattern is the element's equivalent nodal force of that constant eigenstrain
+ *         (sum_g B^T D eps det J w), without another quadrature. */
+static void patterns(const double x[18], double pat[FS_WEDGE_PATTERNS][18])
+{
+    double cb[3] = {0}, ct[3] = {0}, cm[3];
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 3; k++) {
+            cb[k] += x[3 * c + k] / 3.0;
+            ct[k] += x[3 * (c + 3) + k] / 3.0;
+        }
+    for (int k = 0; k < 3; k++)
+        cm[k] = 0.5 * (cb[k] + ct[k]);
+    memset(pat, 0, sizeof(double) * FS_WEDGE_PATTERNS * 18);
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 3; k++) {
+            pat[0][3 * c + k] = x[3 * c + k] - cb[k];
+            pat[1][3 * (c + 3) + k] = x[3 * (c + 3) + k] - ct[k];
+            pat[2][3 * (c + 3) + k] = ct[k] - cb[k];
+        }
+    for (int a = 0; a < 6; a++) {
+        double dx = x[3 * a] - cm[0], dy = x[3 * a + 1] - cm[1];
+        pat[3][3 * a] = dx;
+        pat[4][3 * a + 1] = dy;
+        pat[5][3 * a] = 0.5 * dy;
+        pat[5][3 * a + 1] = 0.5 * dx;
+    }
+}
+
+/* The reference-shape displacement u0 of an element at the current shrinkage coefficients. */
+static void shrink_displacement(const fs_wedge_model *w, const double x[18], double u0[18])
+{
+    double pat[FS_WEDGE_PATTERNS][18];
+    patterns(x, pat);
+    for (int a = 0; a < 18; a++)
+        u0[a] = w->shrink_coef[0] * pat[0][a] + w->shrink_coef[1] * pat[1][a] + w->shrink_coef[2] * pat[2][a];
+}
+
+/* ---- DOFs and node -> element lists ---- */
+
+static int32_t elem_dof(const fs_wedge_model *w, int32_t e, int a)
+{
+    int32_t node = w->mesh->tri[3 * (size_t)e + (a / 3) % 3];
+    int local = a / 9 ? 3 : 0; /* a in 0..17: node a / 3, bottom for nodes 0..2 */
+    return w->dof[6 * (size_t)node + local + a % 3];
+}
+
+/* Numbers the DOFs: free ones (top nodes not pinned) first in node order, then the fixed ones. */
+static void number_dofs(fs_wedge_model *w)
+{
+    int32_t n = w->n_nodes, next = 0;
+    w->dof = fs_realloc(w->dof, 6 * (size_t)n * sizeof *w->dof);
+    for (int32_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++)
+            w->dof[6 * (size_t)i + 3 + k] = w->pinned[i] ? -1 : next++;
+    w->n_free = next;
+    w->fixed_node_dof = fs_realloc(w->fixed_node_dof, 6 * (size_t)n * sizeof *w->fixed_node_dof);
+    for (int32_t i = 0; i < n; i++)
+        for (int l = 0; l < 6; l++) {
+            int32_t *d = w->dof + 6 * (size_t)i + l;
+            if (l < 3 || *d < 0) {
+                w->fixed_node_dof[next - w->n_free] = 6 * i + l;
+                *d = next++;
+            }
+        }
+    w->n_fixed = next - w->n_free;
+}
+
+static void build_node_elems(fs_wedge_model *w)
+{
+    int32_t n = w->n_nodes;
+    free(w->node_elem_start);
+    free(w->node_elem);
+    w->node_elem_start = fs_calloc((size_t)n + 1, sizeof *w->node_elem_start);
+    for (int32_t e = 0; e < w->n_elems; e++)
+        for (int c = 0; c < 3; c++)
+            w->node_elem_start[w->mesh->tri[3 * (size_t)e + c] + 1]++;
+    for (int32_t i = 0; i < n; i++)
+        w->node_elem_start[i + 1] += w->node_elem_start[i];
+    int32_t *fill = fs_malloc(((size_t)n + 1) * sizeof *fill);
+    memcpy(fill, w->node_elem_start, ((size_t)n + 1) * sizeof *fill);
+    w->node_elem = fs_malloc(((size_t)w->node_elem_start[n] + 1) * sizeof *w->node_elem);
+    for (int32_t e = 0; e < w->n_elems; e++)
+        for (int c = 0; c < 3; c++) {
+            int32_t node = w->mesh->tri[3 * (size_t)e + c];
+            /* a node listed twice in one element (tiny periodic meshes) keeps one entry */
+            if (fill[node] > w->node_elem_start[node] && w->node_elem[fill[node] - 1] == e)
+                continue;
+            w->node_elem[fill[node]++] = e;
+        }
+    for (int32_t i = 0; i < n; i++)
+        w->node_elem_count[i] = fill[i] - w->node_elem_start[i];
+    free(fill);
+}
+
+/* Living elements that use node i. */
+static int32_t alive_at_node(const fs_wedge_model *w, int32_t i)
+{
+    int32_t count = 0;
+    for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++)
+        count += w->state[w->node_elem[p]] == FS_WEDGE_ALIVE;
+    return count;
+}
+
+/* ---- element matrices ---- */
+
+static int element_system(const fs_wedge_model *w, int32_t e, double base_thickness, double K[324],
+                             double loads[FS_WEDGE_PATTERNS][18])
+{
+    double x[18], D[36];
+    coords_at(w, e, base_thickness, x);
+    for (int i = 0; i < 36; i++)
+        D[i] = w->young[e] * w->d_unit[i];
+    if (fs_wedge_stiffness(x, D, K) < 0) {
+        fs_error(FS_ERR_DATA, "wedge model: element %d is inverted or degenerate (%s)", (int)e, fs_error_message());
+        return -1;
+    }
+    double pat[FS_WEDGE_PATTERNS][18];
+    patterns(x, pat);
+    int npat = w->growth_mode == FS_WEDGE_GROWTH_EIGENSTRAIN ? FS_WEDGE_PATTERNS : 3;
+    memset(loads, 0, sizeof(double) * FS_WEDGE_PATTERNS * 18);
+    for (int q = 0; q < npat; q++)
+        for (int a = 0; a < 18; a++) {
+            double s = 0.0;
+            for (int c = 0; c < 18; c++)
+                s += K[18 * a + c] * pat[q][c];
+            loads[q][a] = s;
+        }
+    return 0;
+}
+
+/* ---- the sparse system ---- */
+
+static int refresh_cache(fs_wedge_model *w, const int32_t *elems, int32_t n);
+
+static int32_t find_entry(const fs_sparse_matrix *m, int32_t i, int32_t j)
+{
+    int32_t row = i < j ? i : j, col = i < j ? j : i;
+    int32_t lo = m->col_ptr[col], hi = m->col_ptr[col + 1] - 1;
+    while (lo <= hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (m->row_idx[mid] == row)
+            return mid;
+        if (m->row_idx[mid] < row)
+            lo = mid + 1;
+        else
+            hi = mid - 1;
+    }
+    return -1;
+}
+
+/* Calls add(ctx, i, j, value) for every kept pair (a <= c) of the element: fixed-fixed pairs are left
+ * out; two local DOFs on one global DOF (a node repeated in a tiny periodic mesh) add the
+ * off-diagonal term twice, as the full matrix would. */
+static void element_pairs(const fs_wedge_model *w, int32_t e, const double K[324],
+                          void (*add)(void *ctx, int32_t i, int32_t j, double v), void *ctx)
+{
+    int32_t g[18];
+    for (int a = 0; a < 18; a++)
+        g[a] = elem_dof(w, e, a);
+    for (int a = 0; a < 18; a++)
+        for (int c = a; c < 18; c++) {
+            if (g[a] >= w->n_free && g[c] >= w->n_free)
+                continue;
+            double v = K[18 * a + c];
+            if (c != a && g[a] == g[c])
+                v *= 2.0;
+            add(ctx, g[a], g[c], v);
+        }
+}
+
+static void add_to_builder(void *ctx, int32_t i, int32_t j, double v)
+{
+    fs_sparse_builder_add(ctx, i, j, v);
+}
+
+static void add_loads(fs_wedge_model *w, int32_t e, const double loads[FS_WEDGE_PATTERNS][18], const uint8_t *only)
+{
+    for (int a = 0; a < 18; a++) {
+        int32_t g = elem_dof(w, e, a);
+        if (g >= w->n_free || (only && !only[g]))
+            continue;
+        for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
+            w->load[(size_t)q * w->n_free + g] += loads[q][a];
+    }
+}
+
+/* Free DOFs of nodes without a living element get a unit diagonal (their displacement solves to 0). */
+static void fix_orphans(fs_wedge_model *w)
+{
+    for (int32_t i = 0; i < w->n_nodes; i++) {
+        if (alive_at_node(w, i) > 0)
+            continue;
+        for (int k = 3; k < 6; k++) {
+            int32_t g = w->dof[6 * (size_t)i + k];
+            if (g < w->n_free) {
+                int32_t p = find_entry(&w->k_all, g, g);
+                FS_ASSERT(p >= 0);
+                w->k_all.values[p] = 1.0;
+            }
+        }
+    }
+}
+
+static void set_view(fs_wedge_model *w)
+{
+    w->k_free.n = w->n_free;
+    w->k_free.col_ptr = w->k_all.col_ptr;
+    w->k_free.row_idx = w->k_all.row_idx;
+    w->k_free.values = w->k_all.values;
+}
+
+static int factorize(fs_wedge_model *w, bool analyze)
+{
+    if (w->cfg.solver.method != FS_SOLVER_CHOLMOD || w->n_free == 0)
+        return 0;
+    double t0 = fs_seconds();
+    if (analyze || !w->chol) {
+        fs_cholesky_free(w->chol);
+        w->chol = fs_cholesky_analyze(&w->k_free);
+        if (!w->chol)
+            return -1;
+        w->counters.analyses++;
+    }
+    double t1 = fs_seconds();
+    int rc = fs_cholesky_factorize(w->chol, &w->k_free);
+    double t2 = fs_seconds();
+    w->counters.analyze_seconds += t1 - t0;
+    w->counters.factor_seconds += t2 - t1;
+    w->counters.factorizations++;
+    w->updowns_pending = 0;
+    return rc;
+}
+
+/* design: thesis §5.4 assembles K_G from every element and §5.5 eliminates the known (fixed) nodal
+ * coordinates from the system (its second approach), which halves the unknowns. All DOFs go into one
+ * symmetric matrix numbered free-first, without fixed-fixed pairs: its leading block is K_ff, which
+ * the solvers see through a view without a copy, and its other columns hold K_fb, which turns the
+ * prescribed motion of fixed nodes into the right-hand side -K_fb u_b. */
+static int build_system(fs_wedge_model *w)
+{
+    double t0 = fs_seconds();
+    number_dofs(w);
+    build_node_elems(w);
+    int32_t order = w->n_free + w->n_fixed;
+    int32_t alive = 0;
+    for (int32_t e = 0; e < w->n_elems; e++)
+        alive += w->state[e] == FS_WEDGE_ALIVE;
+    fs_sparse_builder b;
+    fs_sparse_builder_init(&b, order, (size_t)alive * 171);
+    free(w->load);
+    w->load = fs_calloc((size_t)FS_WEDGE_PATTERNS * (w->n_free ? w->n_free : 1), sizeof *w->load);
+    double K[324], loads[FS_WEDGE_PATTERNS][18];
+    for (int32_t e = 0; e < w->n_elems; e++) {
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        if (element_system(w, e, w->assembled_thickness, K, loads) < 0) {
+            fs_sparse_builder_free(&b);
+            return -1;
+        }
+        element_pairs(w, e, K, add_to_builder, &b);
+        add_loads(w, e, loads, NULL);
+    }
+    /* every free DOF keeps a diagonal entry, orphans included */
+    for (int32_t g = 0; g < w->n_free; g++)
+        fs_sparse_builder_add(&b, g, g, 0.0);
+    fs_sparse_matrix_free(&w->k_all);
+    int rc = fs_sparse_builder_compress(&b, &w->k_all, NULL);
+    fs_sparse_builder_free(&b);
+    if (rc < 0)
+        return -1;
+    set_view(w);
+    fix_orphans(w);
+    w->rhs = fs_realloc(w->rhs, ((size_t)w->n_free + 1) * sizeof *w->rhs);
+    w->x = fs_realloc(w->x, ((size_t)w->n_free + 1) * sizeof *w->x);
+    memset(w->x, 0, ((size_t)w->n_free + 1) * sizeof *w->x);
+    w->u_fixed = fs_realloc(w->u_fixed, ((size_t)w->n_fixed + 1) * sizeof *w->u_fixed);
+    free(w->mark);
+    w->mark = fs_calloc((size_t)order + 1, sizeof *w->mark);
+    if (refresh_cache(w, NULL, w->n_elems) < 0)
+        return -1;
+    w->counters.assemble_seconds += fs_seconds() - t0;
+    return factorize(w, true);
+}
+
+typedef struct {
+    fs_sparse_matrix *m;
+    const uint8_t *only; /* if not NULL: add only where both DOFs are marked */
+} refill_ctx;
+
+static void add_in_place(void *ctx, int32_t i, int32_t j, double v)
+{
+    refill_ctx *r = ctx;
+    if (r->only && !(r->only[i] && r->only[j]))
+        return;
+    int32_t p = find_entry(r->m, i, j);
+    FS_ASSERT(p >= 0);
+    r->m->values[p] += v;
+}
+
+/* Re-adds the contributions of the living elements in `elems` (ascending) into the pattern: all of
+ * them when only is NULL, else only the entries and loads whose DOFs are all marked in only. */
+static int readd(fs_wedge_model *w, const int32_t *elems, int32_t n, const uint8_t *only)
+{
+    double K[324], loads[FS_WEDGE_PATTERNS][18];
+    refill_ctx r = {&w->k_all, only};
+    for (int32_t q = 0; q < n; q++) {
+        int32_t e = elems ? elems[q] : q;
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        if (element_system(w, e, w->assembled_thickness, K, loads) < 0)
+            return -1;
+        element_pairs(w, e, K, add_in_place, &r);
+        add_loads(w, e, loads, only);
+    }
+    return 0;
+}
+
+/* New values on the same pattern (a changed thickness): zero, re-add every living element in order,
+ * so the values are those a fresh assembly gives, and re-factorize without a new analysis. */
+static int refill_system(fs_wedge_model *w, double base_thickness)
+{
+    double t0 = fs_seconds();
+    w->assembled_thickness = base_thickness;
+    fs_sparse_matrix_zero(&w->k_all);
+    memset(w->load, 0, (size_t)FS_WEDGE_PATTERNS * w->n_free * sizeof *w->load);
+    if (readd(w, NULL, w->n_elems, NULL) < 0 || refresh_cache(w, NULL, w->n_elems) < 0)
+        return -1;
+    fix_orphans(w);
+    w->counters.assemble_seconds += fs_seconds() - t0;
+    return factorize(w, false);
+}
+
+/* ---- equilibrium ---- */
+
+/* Displacement of the fixed DOFs at time t: the prescribed values plus the growth motion of the
+ * bottom nodes (moving mode). */
+static void fixed_displacements(fs_wedge_model *w, double t)
+{
+    const fs_mesh *m = w->mesh;
+    for (int32_t j = 0; j < w->n_fixed; j++) {
+        int32_t nd = w->fixed_node_dof[j];
+        w->u_fixed[j] = w->prescribed[nd];
+    }
+    if (w->growth_mode != FS_WEDGE_GROWTH_MOVE)
+        return;
+    for (int32_t i = 0; i < w->n_nodes; i++) {
+        const double *p = m->pos + 3 * (size_t)i;
+        double q[3];
+        fs_growth_flow(&w->growth, p, 0.0, t, q);
+        for (int k = 0; k < 3; k++) {
+            int32_t g = w->dof[6 * (size_t)i + k];
+            w->u_fixed[g - w->n_free] += q[k] - p[k];
+        }
+    }
+}
+
+static void build_rhs(fs_wedge_model *w)
+{
+    int32_t nf = w->n_free;
+    double coef[FS_WEDGE_PATTERNS] = {w->shrink_coef[0], w->shrink_coef[1], w->shrink_coef[2],
+                                      w->eigenstrain[0], w->eigenstrain[1], w->eigenstrain[2]};
+    for (int32_t i = 0; i < nf; i++) {
+        double s = 0.0;
+        for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
+            s += coef[q] * w->load[(size_t)q * nf + i];
+        w->rhs[i] = s;
+    }
+    const fs_sparse_matrix *k = &w->k_all;
+    for (int32_t j = nf; j < nf + w->n_fixed; j++) {
+        double uj = w->u_fixed[j - nf];
+        if (uj == 0.0)
+            continue;
+        for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++) {
+            int32_t r = k->row_idx[p];
+            if (r < nf)
+                w->rhs[r] -= k->values[p] * uj;
+        }
+    }
+}
+
+static int solve(fs_wedge_model *w)
+{
+    double t0 = fs_seconds();
+    int rc = 0;
+    if (w->n_free == 0) {
+    } else if (w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
+        rc = fs_cholesky_solve(w->chol, 1, w->rhs, w->x);
+    } else {
+        fs_cg_params p = fs_cg_params_default();
+        p.tolerance = w->cfg.solver.tolerance;
+        p.max_iterations = w->cfg.solver.max_iterations;
+        int it = fs_cg_solve(&w->k_free, w->rhs, w->x, p, NULL);
+        if (it < 0)
+            rc = -1;
+        else
+            w->counters.cg_iterations += it;
+    }
+    w->counters.solves++;
+    w->counters.solve_seconds += fs_seconds() - t0;
+    return rc;
+}
+
+static void gather_u(const fs_wedge_model *w, int32_t e, double ue[18])
+{
+    const int32_t *tri = w->mesh->tri + 3 * (size_t)e;
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 3; k++) {
+            ue[3 * c + k] = w->u[6 * (size_t)tri[c] + k];
+            ue[3 * (c + 3) + k] = w->u[6 * (size_t)tri[c] + 3 + k];
+        }
+}
+
+/* Stress from a strain net of the eigenstrain: sigma = E D1 (strain - eps0). */
+static void stress_of(const fs_wedge_model *w, int32_t e, const double strain[6], double stress[6])
+{
+    double eps[6] = {strain[0] - w->eigenstrain[0], strain[1] - w->eigenstrain[1], strain[2],
+                     strain[3] - w->eigenstrain[2], strain[4], strain[5]};
+    for (int i = 0; i < 6; i++) {
+        double s = 0.0;
+        for (int j = 0; j < 6; j++)
+            s += w->d_unit[6 * i + j] * eps[j];
+        stress[i] = w->young[e] * s;
+    }
+}
+
+int fs_wedge_element_stress(const fs_wedge_model *w, int32_t e, double r, double s, double zeta, double stress[6])
+{
+    double x[18], ue[18], u0[18], strain[6];
+    fs_wedge_element_coords(w, e, x);
+    gather_u(w, e, ue);
+    shrink_displacement(w, x, u0);
+    for (int a = 0; a < 18; a++)
+        ue[a] -= u0[a];
+    if (fs_wedge_strain(x, ue, r, s, zeta, strain) < 0)
+        return -1;
+    stress_of(w, e, strain, stress);
+    return 0;
+}
+
+/* Per-element cache of what the stress check needs at the three top Gauss points: dN/dx (3 x 18)
+ * and the strains of the three shrinkage patterns (3 x 3 x 6), so that a stress costs a few hundred
+ * flops. Valid while the element's geometry is: refreshed on assembly, thickness change and
+ * subdivision. */
+#define GAUSS_CACHE 108
+
+/* Strain (Voigt, engineering shears) of nodal displacements u from the shape-function gradients. */
+static void strain_from_gradients(const double dndx[18], const double u[18], double strain[6])
+{
+    double g[3][3] = {{0}};
+    for (int n = 0; n < 6; n++)
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                g[i][j] += dndx[3 * n + j] * u[3 * n + i];
+    strain[0] = g[0][0];
+    strain[1] = g[1][1];
+    strain[2] = g[2][2];
+    strain[3] = g[0][1] + g[1][0];
+    strain[4] = g[1][2] + g[2][1];
+    strain[5] = g[2][0] + g[0][2];
+}
+
+static int refresh_cache(fs_wedge_model *w, const int32_t *elems, int32_t n)
+{
+    for (int32_t q = 0; q < n; q++) {
+        int32_t e = elems ? elems[q] : q;
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        double x[18], pat[FS_WEDGE_PATTERNS][18], detj;
+        fs_wedge_element_coords(w, e, x);
+        patterns(x, pat);
+        double *c = w->gauss_cache + GAUSS_CACHE * (size_t)e;
+        for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
+            double *dndx = c + 18 * g;
+            if (fs_wedge_gradients(x, fs_wedge_gauss[g][0], fs_wedge_gauss[g][1], fs_wedge_gauss[g][2], dndx, &detj) < 0) {
+                fs_error(FS_ERR_DATA, "wedge model: element %d is inverted or degenerate (det J = %g)", (int)e, detj);
+                return -1;
+            }
+            for (int k = 0; k < 3; k++)
+                strain_from_gradients(dndx, pat[k], c + 54 + 18 * g + 6 * k);
+        }
+    }
+    return 0;
+}
+
+/* Relative margin added to the closed-form largest eigenvalue so that it bounds the exact one: the
+ * trigonometric formula loses up to about sqrt(machine epsilon) of the deviator's size when the
+ * eigenvalues nearly coincide. */
+#define CLOSED_FORM_MARGIN 1e-6
+
+/* An upper bound of the largest eigenvalue of a symmetric stress (Voigt), tight where it reaches
+ * `level`. Cheap bounds first: the largest of the in-plane 2 x 2 block's eigenvalues and sigma_zz
+ * plus the Frobenius norm of the out-of-plane shears (Weyl's inequality; tight near a flat layer's
+ * free top), and the mean stress plus sqrt(2/3) times the deviator's Frobenius norm (any frame, so
+ * also on the sphere). Where both reach `level`, the closed-form (trigonometric) largest eigenvalue
+ * plus a safety margin. */
+static double principal_bound(const double s[6], double level)
+{
+    double mean = 0.5 * (s[0] + s[1]), half = 0.5 * (s[0] - s[1]);
+    double in_plane = mean + sqrt(half * half + s[3] * s[3]);
+    double bound = fmax(in_plane, s[2]) + sqrt(2.0 * (s[4] * s[4] + s[5] * s[5]));
+    double q = (s[0] + s[1] + s[2]) / 3.0;
+    double d0 = s[0] - q, d1 = s[1] - q, d2 = s[2] - q;
+    double shear2 = s[3] * s[3] + s[4] * s[4] + s[5] * s[5];
+    double dev2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * shear2;
+    bound = fmin(bound, q + sqrt(2.0 * dev2 / 3.0));
+    bound += 1e-12 * (fabs(q) + sqrt(dev2)); /* the kernel's own rounding */
+    if (bound <= level || dev2 == 0.0)
+        return bound;
+    double p = sqrt(dev2 / 6.0);
+    double b0 = d0 / p, b1 = d1 / p, b2 = d2 / p, b3 = s[3] / p, b4 = s[4] / p, b5 = s[5] / p;
+    double det = b0 * (b1 * b2 - b4 * b4) - b3 * (b3 * b2 - b4 * b5) + b5 * (b3 * b4 - b1 * b5);
+    double r = fmin(1.0, fmax(-1.0, 0.5 * det));
+    double largest = q + 2.0 * p * cos(acos(r) / 3.0);
+    return fmin(bound, largest + CLOSED_FORM_MARGIN * (fabs(q) + 2.0 * p));
+}
+
+double fs_wedge_element_ratio(const fs_wedge_model *w, int32_t e)
+{
+    if (w->state[e] != FS_WEDGE_ALIVE)
+        return NAN;
+    double best = -INFINITY, sigma[3];
+    for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
+        if (fs_eigen_principal_stress(w->stress_top + 18 * (size_t)e + 6 * g, sigma, NULL) < 0)
+            return NAN;
+        best = fmax(best, sigma[0]);
+    }
+    return best / w->threshold[e];
+}
+
+typedef struct {
+    double bound;
+    int32_t e;
+} bound_entry;
+
+static int cmp_bound_desc(const void *a, const void *b)
+{
+    const bound_entry *x = a, *y = b;
+    if (x->bound != y->bound)
+        return x->bound < y->bound ? 1 : -1;
+    return (x->e > y->e) - (x->e < y->e);
+}
+
+/* design: thesis §5.6.1 evaluates the stress at the three Gauss points nearest the top face ("the
+ * resulting 9 values are sorted, and the largest one is compared against the material's threshold
+ * stress"). Every fracture decision asks only whether the largest ratio exceeds 1 and which element
+ * has it (fracture/rank.h, ties within FS_RANK_TIE_REL), so the shared eigen kernel runs only on the
+ * elements whose upper bound (principal_bound) could reach the largest exact ratio, in descending order of the
+ * bound, until the next bound falls below the best exact ratio found (less the tie tolerance). Every
+ * other ratio holds its bound. */
+static int element_ratios(fs_wedge_model *w)
+{
+    double t0 = fs_seconds();
+    int32_t n_over = 0;
+    for (int32_t e = 0; e < w->n_elems; e++) {
+        if (w->state[e] != FS_WEDGE_ALIVE) {
+            w->ratio[e] = NAN;
+            continue;
+        }
+        double ue[18];
+        gather_u(w, e, ue);
+        const double *c = w->gauss_cache + GAUSS_CACHE * (size_t)e;
+        double *st = w->stress_top + 18 * (size_t)e, bound = -INFINITY;
+        for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
+            double strain[6];
+            strain_from_gradients(c + 18 * g, ue, strain);
+            for (int k = 0; k < 3; k++)
+                for (int v = 0; v < 6; v++)
+                    strain[v] -= w->shrink_coef[k] * c[54 + 18 * g + 6 * k + v];
+            stress_of(w, e, strain, st + 6 * g);
+            bound = fmax(bound, principal_bound(st + 6 * g, w->threshold[e]));
+        }
+        w->ratio[e] = bound / w->threshold[e];
+        if (w->ratio[e] > 1.0)
+            n_over++;
+    }
+    if (n_over > 0) {
+        bound_entry *list = fs_malloc((size_t)n_over * sizeof *list);
+        int32_t n = 0;
+        for (int32_t e = 0; e < w->n_elems; e++)
+            if (w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0)
+                list[n++] = (bound_entry){w->ratio[e], e};
+        qsort(list, (size_t)n, sizeof *list, cmp_bound_desc);
+        double best = -INFINITY;
+        for (int32_t q = 0; q < n; q++) {
+            if (list[q].bound < best - 2.0 * FS_RANK_TIE_REL * fabs(best))
+                break;
+            double r = fs_wedge_element_ratio(w, list[q].e);
+            if (isnan(r)) {
+                free(list);
+                return -1;
+            }
+            w->ratio[list[q].e] = r;
+            best = fmax(best, r);
+        }
+        free(list);
+    }
+    w->counters.stress_seconds += fs_seconds() - t0;
+    return 0;
+}
+
+int fs_wedge_equilibrium(fs_wedge_model *w, double t)
+{
+    double h = layer_thickness(w, t);
+    if (h != w->assembled_thickness && refill_system(w, h) < 0)
+        return -1;
+    double scale[3];
+    fs_shrink_scales(&w->cfg.shrink, t, scale);
+    for (int k = 0; k < 3; k++)
+        w->shrink_coef[k] = scale[k] - 1.0;
+    w->eigenstrain[0] = w->eigenstrain[1] = w->eigenstrain[2] = 0.0;
+    if (w->growth_mode == FS_WEDGE_GROWTH_EIGENSTRAIN) {
+        double v[3];
+        fs_growth_strain(&w->growth, 0.0, t, NULL, v);
+        for (int k = 0; k < 3; k++)
+            w->eigenstrain[k] = -v[k];
+    }
+    fixed_displacements(w, t);
+    build_rhs(w);
+    if (solve(w) < 0)
+        return -1;
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        for (int l = 0; l < 6; l++) {
+            int32_t g = w->dof[6 * (size_t)i + l];
+            w->u[6 * (size_t)i + l] = g < w->n_free ? w->x[g] : w->u_fixed[g - w->n_free];
+        }
+    w->time = t;
+    return element_ratios(w);
+}
+
+double fs_wedge_max_ratio(const fs_wedge_model *w)
+{
+    double best = -INFINITY;
+    for (int32_t e = 0; e < w->n_elems; e++)
+        if (w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > best)
+            best = w->ratio[e];
+    return best;
+}
+
+int fs_wedge_nodal_stress(const fs_wedge_model *w, int32_t node, bool top, double stress[6])
+{
+    /* The Gauss point nearest corner c: (2/3, 1/6) for node 0 (r = 1), (1/6, 2/3) for node 1 (s = 1),
+     * (1/6, 1/6) for node 2; the top row of Table 5.1 for top nodes, the bottom row otherwise. */
+    memset(stress, 0, 6 * sizeof *stress);
+    int count = 0;
+    for (int32_t p = w->node_elem_start[node]; p < w->node_elem_start[node] + w->node_elem_count[node]; p++) {
+        int32_t e = w->node_elem[p];
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        int c = 0;
+        while (c < 3 && w->mesh->tri[3 * (size_t)e + c] != node)
+            c++;
+        FS_ASSERT(c < 3);
+        const double *g = fs_wedge_gauss[(top ? 0 : 6) + c];
+        double s[6];
+        if (fs_wedge_element_stress(w, e, g[0], g[1], g[2], s) < 0)
+            return -1;
+        for (int k = 0; k < 6; k++)
+            stress[k] += s[k];
+        count++;
+    }
+    for (int k = 0; k < 6 && count; k++)
+        stress[k] /= count;
+    return count;
+}
+
+/* ---- construction ---- */
+
+/* Per-element materials: Young's modulus and threshold with their maps, threshold jitter by element id. */
+static void element_materials(fs_wedge_model *w, int32_t e, const grey_map *ymap, const grey_map *tmap)
+{
+    const fs_material *mat = &w->cfg.material;
+    double corner[3][3];
+    for (int c = 0; c < 3; c++)
+        fs_mesh_corner(w->mesh, e, c, corner[c]);
+    w->young[e] = mat->young * map_average(ymap, &w->mesh->domain, corner);
+    double jitter = 1.0 + mat->jitter * (2.0 * fs_rand01(w->cfg.preset.seed, FS_RNG_JITTER, (uint64_t)e) - 1.0);
+    w->threshold[e] = 1e-3 * mat->threshold * jitter * map_average(tmap, &w->mesh->domain, corner);
+}
+
+static void grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
+{
+    size_t nn = (size_t)n_nodes, ne = (size_t)n_elems;
+    w->normal = fs_realloc(w->normal, 3 * nn * sizeof *w->normal);
+    w->thickness_factor = fs_realloc(w->thickness_factor, nn * sizeof *w->thickness_factor);
+    w->pinned = fs_realloc(w->pinned, nn * sizeof *w->pinned);
+    w->prescribed = fs_realloc(w->prescribed, 6 * nn * sizeof *w->prescribed);
+    w->u = fs_realloc(w->u, 6 * nn * sizeof *w->u);
+    w->node_elem_count = fs_realloc(w->node_elem_count, nn * sizeof *w->node_elem_count);
+    for (size_t i = (size_t)w->n_nodes; i < nn; i++) {
+        w->pinned[i] = 0;
+        memset(w->prescribed + 6 * i, 0, 6 * sizeof *w->prescribed);
+        memset(w->u + 6 * i, 0, 6 * sizeof *w->u);
+        node_normal(w, (int32_t)i, w->normal + 3 * i);
+    }
+    w->state = fs_realloc(w->state, ne * sizeof *w->state);
+    w->young = fs_realloc(w->young, ne * sizeof *w->young);
+    w->threshold = fs_realloc(w->threshold, ne * sizeof *w->threshold);
+    w->ratio = fs_realloc(w->ratio, ne * sizeof *w->ratio);
+    w->stress_top = fs_realloc(w->stress_top, 18 * ne * sizeof *w->stress_top);
+    w->gauss_cache = fs_realloc(w->gauss_cache, GAUSS_CACHE * ne * sizeof *w->gauss_cache);
+    for (size_t e = (size_t)w->n_elems; e < ne; e++) {
+        w->state[e] = FS_WEDGE_ALIVE;
+        w->ratio[e] = NAN;
+        memset(w->stress_top + 18 * e, 0, 18 * sizeof *w->stress_top);
+    }
+    w->n_nodes = n_nodes;
+    w->n_elems = n_elems;
+}
+
+int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg)
+{
+    memset(w, 0, sizeof *w);
+    w->mesh = mesh;
+    w->cfg = *cfg;
+    fs_domain_normalize(&w->mesh->domain);
+    const fs_domain *d = &mesh->domain;
+    w->flat = d->type != FS_DOMAIN_SPHERE;
+    w->time = 0.0;
+
+    if (fs_wedge_elasticity(1.0, cfg->material.poisson, w->d_unit) < 0 || !(cfg->material.young > 0.0) ||
+        !(cfg->material.threshold > 0.0)) {
+        fs_error(FS_ERR_DATA, "[material] young, poisson, threshold: expected E > 0, -1 < nu < 0.5 and a "
+                 "positive threshold, got %g MPa, %g, %g kPa", cfg->material.young, cfg->material.poisson,
+                 cfg->material.threshold);
+        return -1;
+    }
+    if (fs_shrink_check(&cfg->shrink) < 0)
+        return -1;
+    if (fs_growth_field_init(&w->growth, &cfg->growth, NULL, d, cfg->time.end) < 0)
+        return -1;
+    if (w->growth.type == FS_GROWTH_NONE)
+        w->growth_mode = FS_WEDGE_GROWTH_NONE;
+    else if (d->type == FS_DOMAIN_CYLINDER || (d->type == FS_DOMAIN_PLANE && (d->periodic_x || d->periodic_y)))
+        w->growth_mode = FS_WEDGE_GROWTH_EIGENSTRAIN;
+    else
+        w->growth_mode = FS_WEDGE_GROWTH_MOVE;
+
+    grey_map thick = {0}, ymap = {0}, tmap = {0};
+    if (map_load(cfg->material.thickness_map, d, &thick) < 0 || map_load(cfg->material.young_map, d, &ymap) < 0 ||
+        map_load(cfg->material.threshold_map, d, &tmap) < 0) {
+        map_free(&thick);
+        map_free(&ymap);
+        fs_wedge_free(w);
+        return -1;
+    }
+    grow_arrays(w, mesh->n_nodes, mesh->n_tris);
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        w->thickness_factor[i] = node_thickness_factor(w, &thick, i);
+    for (int32_t e = 0; e < w->n_elems; e++)
+        element_materials(w, e, &ymap, &tmap);
+    map_free(&thick);
+    map_free(&ymap);
+    map_free(&tmap);
+
+    w->assembled_thickness = layer_thickness(w, 0.0);
+    if (build_system(w) < 0) {
+        fs_wedge_free(w);
+        return -1;
+    }
+    return 0;
+}
+
+int fs_wedge_pin_top(fs_wedge_model *w, const uint8_t *pinned)
+{
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        w->pinned[i] = pinned[i] != 0;
+    return build_system(w);
+}
+
+void fs_wedge_free(fs_wedge_model *w)
+{
+    free(w->normal);
+    free(w->thickness_factor);
+    free(w->pinned);
+    free(w->prescribed);
+    free(w->u);
+    free(w->state);
+    free(w->young);
+    free(w->threshold);
+    free(w->ratio);
+    free(w->stress_top);
+    free(w->gauss_cache);
+    free(w->dof);
+    free(w->fixed_node_dof);
+    free(w->node_elem_start);
+    free(w->node_elem);
+    free(w->node_elem_count);
+    fs_sparse_matrix_free(&w->k_all);
+    free(w->load);
+    free(w->rhs);
+    free(w->x);
+    free(w->u_fixed);
+    free(w->mark);
+    fs_cholesky_free(w->chol);
+    memset(w, 0, sizeof *w);
+}
+
+/* ---- mesh changes: removal (Algorithm 7) and subdivision (Algorithms 8-9) ---- */
+
+/* Rank updates of the factor before a numeric re-factorization instead; the updates cost a small
+ * fraction of a factorization each (bench/bench_wedge measures both), and a periodic fresh factor
+ * bounds the round-off that downdates accumulate and restores the faster supernodal solves. */
+#define UPDOWN_LIMIT 128
+
+static int cmp_int32(const void *a, const void *b)
+{
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* design: thesis Algorithm 7 (removal by reconstruction), generalised to any set of nodes whose
+ * elements changed. Every entry of the system coupling two DOFs of the nodes in S, and every load at
+ * those DOFs, is set to zero and rebuilt from the living elements touching S, in ascending element
+ * order: the values are then exactly those of a fresh assembly (no drift from repeated subtraction,
+ * Algorithm 6), and entries no element feeds any more become exact zeros. */
+static int update_region(fs_wedge_model *w, const int32_t *nodes, int32_t n)
+{
+    int32_t *dofs = fs_malloc(6 * (size_t)(n ? n : 1) * sizeof *dofs);
+    int32_t nd = 0;
+    for (int32_t q = 0; q < n; q++)
+        for (int l = 0; l < 6; l++) {
+            int32_t g = w->dof[6 * (size_t)nodes[q] + l];
+            if (!w->mark[g]) {
+                w->mark[g] = 1;
+                dofs[nd++] = g;
+            }
+        }
+    fs_sparse_matrix *k = &w->k_all;
+    for (int32_t q = 0; q < nd; q++) {
+        int32_t j = dofs[q];
+        for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++)
+            if (w->mark[k->row_idx[p]])
+                k->values[p] = 0.0;
+        if (j < w->n_free)
+            for (int pat = 0; pat < FS_WEDGE_PATTERNS; pat++)
+                w->load[(size_t)pat * w->n_free + j] = 0.0;
+    }
+    int32_t cap = 0, ne = 0;
+    for (int32_t q = 0; q < n; q++)
+        cap += w->node_elem_count[nodes[q]];
+    int32_t *elems = fs_malloc((size_t)(cap ? cap : 1) * sizeof *elems);
+    for (int32_t q = 0; q < n; q++) {
+        int32_t i = nodes[q];
+        for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++)
+            if (w->state[w->node_elem[p]] == FS_WEDGE_ALIVE)
+                elems[ne++] = w->node_elem[p];
+    }
+    qsort(elems, (size_t)ne, sizeof *elems, cmp_int32);
+    int32_t unique = 0;
+    for (int32_t q = 0; q < ne; q++)
+        if (unique == 0 || elems[unique - 1] != elems[q])
+            elems[unique++] = elems[q];
+    int rc = readd(w, elems, unique, w->mark);
+    for (int32_t q = 0; q < n; q++) {
+        int32_t i = nodes[q];
+        if (alive_at_node(w, i) > 0)
+            continue;
+        for (int l = 3; l < 6; l++) {
+            int32_t g = w->dof[6 * (size_t)i + l];
+            if (g < w->n_free)
+                k->values[find_entry(k, g, g)] = 1.0;
+        }
+    }
+    for (int32_t q = 0; q < nd; q++)
+        w->mark[dofs[q]] = 0;
+    free(dofs);
+    free(elems);
+    return rc;
+}
+
+/* Dense Cholesky a = L L' of an m x m symmetric matrix in place (row-major, lower triangle used and
+ * overwritten with L, the upper set to 0). Returns 0, or -1 if a pivot is not positive. */
+static int dense_cholesky(double *a, int m)
+{
+    for (int j = 0; j < m; j++) {
+        double d = a[m * j + j];
+        for (int k = 0; k < j; k++)
+            d -= a[m * j + k] * a[m * j + k];
+        if (!(d > 0.0))
+            return -1;
+        d = sqrt(d);
+        a[m * j + j] = d;
+        for (int i = j + 1; i < m; i++) {
+            double v = a[m * i + j];
+            for (int k = 0; k < j; k++)
+                v -= a[m * i + k] * a[m * j + k];
+            a[m * i + j] = v / d;
+        }
+        for (int i = 0; i < j; i++)
+            a[m * i + j] = 0.0;
+    }
+    return 0;
+}
+
+/* design: the factor of K_ff after a removal is that of K_ff - K_e,ff (+ a unit diagonal for DOFs left
+ * without an element): a rank-m downdate with W = the Cholesky factor of the element's free-free
+ * block (m <= 9, positive definite because the element's bottom is fixed), preceded by a rank update
+ * with the unit vectors of the orphaned DOFs so that no intermediate matrix is singular. CHOLMOD
+ * changes only the columns of L on the paths from those rows to the root of the elimination tree:
+ * far cheaper than a factorization, which is done instead after UPDOWN_LIMIT updates or if a
+ * downdate fails numerically. */
+static int update_factor_after_removal(fs_wedge_model *w, const double K[324], const int32_t *g,
+                                       const int32_t *orphans, int32_t n_orphans)
+{
+    if (!w->chol)
+        return 0;
+    if (w->updowns_pending >= UPDOWN_LIMIT)
+        return factorize(w, false);
+    double t0 = fs_seconds();
+    int32_t uniq[18], m = 0, local_to_u[18];
+    for (int a = 0; a < 18; a++) {
+        local_to_u[a] = -1;
+        if (g[a] >= w->n_free)
+            continue;
+        int u = 0;
+        while (u < m && uniq[u] != g[a])
+            u++;
+        if (u == m)
+            uniq[m++] = g[a];
+        local_to_u[a] = u;
+    }
+    double M[18 * 18] = {0};
+    for (int a = 0; a < 18; a++)
+        for (int c = 0; c < 18; c++)
+            if (local_to_u[a] >= 0 && local_to_u[c] >= 0)
+                M[m * local_to_u[a] + local_to_u[c]] += K[18 * a + c];
+    int rc = 0;
+    if (n_orphans > 0) {
+        int32_t cp[28], ri[27];
+        double v[27];
+        for (int32_t q = 0; q < n_orphans; q++) {
+            cp[q] = q;
+            ri[q] = orphans[q];
+            v[q] = 1.0;
+        }
+        cp[n_orphans] = n_orphans;
+        rc = fs_cholesky_updown(w->chol, +1, n_orphans, cp, ri, v);
+    }
+    if (rc == 0 && m > 0 && dense_cholesky(M, m) == 0) {
+        int32_t cp[19], ri[18 * 18];
+        double v[18 * 18];
+        int32_t nz = 0;
+        for (int c = 0; c < m; c++) {
+            cp[c] = nz;
+            for (int r = c; r < m; r++) {
+                ri[nz] = uniq[r];
+                v[nz++] = M[m * r + c];
+            }
+        }
+        cp[m] = nz;
+        rc = fs_cholesky_updown(w->chol, -1, m, cp, ri, v);
+    } else if (m > 0) {
+        rc = -1;
+    }
+    w->counters.update_seconds += fs_seconds() - t0;
+    if (rc == 0) {
+        w->counters.updowns++;
+        w->updowns_pending++;
+        return 0;
+    }
+    fs_error_clear();
+    return factorize(w, false);
+}
+
+int fs_wedge_remove(fs_wedge_model *w, int32_t e)
+{
+    FS_ASSERT(e >= 0 && e < w->n_elems && w->state[e] == FS_WEDGE_ALIVE);
+    double K[324], loads[FS_WEDGE_PATTERNS][18];
+    if (element_system(w, e, w->assembled_thickness, K, loads) < 0)
+        return -1;
+    int32_t g[18];
+    for (int a = 0; a < 18; a++)
+        g[a] = elem_dof(w, e, a);
+    double t0 = fs_seconds();
+    w->state[e] = FS_WEDGE_REMOVED;
+    w->ratio[e] = NAN;
+    const int32_t *nodes = w->mesh->tri + 3 * (size_t)e;
+    if (update_region(w, nodes, 3) < 0)
+        return -1;
+    w->counters.assemble_seconds += fs_seconds() - t0;
+    int32_t orphans[9], n_orphans = 0;
+    for (int c = 0; c < 3; c++) {
+        if (alive_at_node(w, nodes[c]) > 0)
+            continue;
+        for (int k = 3; k < 6; k++) {
+            int32_t d = w->dof[6 * (size_t)nodes[c] + k];
+            bool seen = false;
+            for (int32_t q = 0; q < n_orphans; q++)
+                seen |= orphans[q] == d;
+            if (d < w->n_free && !seen)
+                orphans[n_orphans++] = d;
+        }
+    }
+    w->fractures++;
+    w->counters.removals++;
+    return update_factor_after_removal(w, K, g, orphans, n_orphans);
+}
+
+/* design: the new pattern after a subdivision is the old one plus the pairs of the changed and new
+ * elements. New nodes are appended and the DOFs keep their order (free ones in node order, then the
+ * fixed ones), so old indices map monotonically into the new numbering (free DOFs stay, fixed ones
+ * move up by the number of new free DOFs) and each column of the new matrix is a merge of the mapped
+ * old column with the sorted new rows. Entries whose element vanished stay in the pattern as zeros.
+ * Values are copied and then rebuilt around the changed nodes (update_region), so nothing is
+ * assembled twice; the pattern changed, so the factor is analysed and computed afresh. */
+static int cmp_int64(const void *a, const void *b)
+{
+    int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static void push_pair(int64_t **pairs, size_t *np, size_t *cap, int64_t key)
+{
+    if (*np == *cap) {
+        *cap = *cap ? 2 * *cap : 256;
+        *pairs = fs_realloc(*pairs, *cap * sizeof **pairs);
+    }
+    (*pairs)[(*np)++] = key;
+}
+
+static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_old, const int32_t *elems,
+                         int32_t n_changed)
+{
+    int32_t nf = w->n_free, order = w->n_free + w->n_fixed, shift = nf - n_free_old;
+    int32_t order_old = n_free_old + n_fixed_old;
+    size_t cap = 0, np = 0;
+    int64_t *pairs = NULL;
+    for (int32_t q = 0; q < n_changed; q++) {
+        int32_t e = elems[q];
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        int32_t g[18];
+        for (int a = 0; a < 18; a++)
+            g[a] = elem_dof(w, e, a);
+        for (int a = 0; a < 18; a++)
+            for (int c = a; c < 18; c++) {
+                if (g[a] >= nf && g[c] >= nf)
+                    continue;
+                int32_t row = g[a] < g[c] ? g[a] : g[c], col = g[a] < g[c] ? g[c] : g[a];
+                push_pair(&pairs, &np, &cap, (int64_t)col * order + row);
+            }
+    }
+    for (int32_t j = 0; j < order; j++) { /* diagonals of the new columns */
+        bool is_new = (j >= n_free_old && j < nf) || j - nf >= n_fixed_old;
+        if (is_new)
+            push_pair(&pairs, &np, &cap, (int64_t)j * order + j);
+    }
+    qsort(pairs, np, sizeof *pairs, cmp_int64);
+
+    fs_sparse_matrix old = w->k_all, k;
+    k.n = order;
+    k.col_ptr = fs_malloc(((size_t)order + 1) * sizeof *k.col_ptr);
+    size_t cap_nz = (size_t)old.col_ptr[order_old] + np + 1;
+    k.row_idx = fs_malloc(cap_nz * sizeof *k.row_idx);
+    k.values = fs_malloc(cap_nz * sizeof *k.values);
+    size_t nz = 0, pp = 0;
+    for (int32_t j = 0; j < order; j++) {
+        int32_t jo = j < n_free_old ? j : (j >= nf && j - nf < n_fixed_old) ? n_free_old + (j - nf) : -1;
+        int32_t po = jo >= 0 ? old.col_ptr[jo] : 0, po_end = jo >= 0 ? old.col_ptr[jo + 1] : 0;
+        k.col_ptr[j] = (int32_t)nz;
+        for (;;) {
+            int64_t r_old = po < po_end ? (old.row_idx[po] < n_free_old ? old.row_idx[po] : old.row_idx[po] + shift) : INT64_MAX;
+            int64_t r_new = pp < np && pairs[pp] / order == j ? pairs[pp] % order : INT64_MAX;
+            if (r_old == INT64_MAX && r_new == INT64_MAX)
+                break;
+            int64_t r = r_old < r_new ? r_old : r_new;
+            double v = 0.0;
+            if (r_old == r)
+                v = old.values[po++];
+            while (pp < np && pairs[pp] / order == j && pairs[pp] % order == r)
+                pp++;
+            k.row_idx[nz] = (int32_t)r;
+            k.values[nz++] = v;
+        }
+    }
+    k.col_ptr[order] = (int32_t)nz;
+    if (nz > INT32_MAX) {
+        free(pairs);
+        fs_sparse_matrix_free(&k);
+        fs_error(FS_ERR_INTERNAL, "wedge model: the stiffness matrix outgrew 32-bit indices");
+        return -1;
+    }
+    free(pairs);
+    fs_sparse_matrix_free(&w->k_all);
+    w->k_all = k;
+    set_view(w);
+
+    double *load = fs_calloc((size_t)FS_WEDGE_PATTERNS * (nf ? nf : 1), sizeof *load);
+    for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
+        memcpy(load + (size_t)q * nf, w->load + (size_t)q * n_free_old, (size_t)n_free_old * sizeof *load);
+    free(w->load);
+    w->load = load;
+    w->rhs = fs_realloc(w->rhs, ((size_t)nf + 1) * sizeof *w->rhs);
+    w->x = fs_realloc(w->x, ((size_t)nf + 1) * sizeof *w->x);
+    for (int32_t i = n_free_old; i < nf; i++)
+        w->x[i] = 0.0;
+    w->u_fixed = fs_realloc(w->u_fixed, ((size_t)w->n_fixed + 1) * sizeof *w->u_fixed);
+    free(w->mark);
+    w->mark = fs_calloc((size_t)order + 1, sizeof *w->mark);
+    return 0;
+}
+
+/* Marks the listed triangles and returns their descendants after one refinement call: a listed
+ * triangle keeps its slot and new triangles name their pre-call ancestor. */
+static int32_t descendants(const fs_refine_change *ch, const int32_t *list, int32_t n, uint8_t *flag, int32_t *out)
+{
+    int32_t m = 0;
+    for (int32_t q = 0; q < n; q++)
+        if (!flag[list[q]]) {
+            flag[list[q]] = 1;
+            out[m++] = list[q];
+        }
+    for (int32_t q = 0; q < ch->n_new_tris; q++)
+        if (flag[ch->tri_parent[q]])
+            out[m++] = ch->n_tris_before + q;
+    for (int32_t q = 0; q < n; q++)
+        flag[list[q]] = 0;
+    return m;
+}
+
+int fs_wedge_subdivide(fs_wedge_model *w, const int32_t *elems, int32_t n, bool to_min_size, int32_t *bisected)
+{
+    double t0 = fs_seconds();
+    *bisected = 0;
+    int32_t n_tris0 = w->n_elems, n_free_old = w->n_free, n_fixed_old = w->n_fixed;
+    double min_size = w->cfg.mesh.min_size;
+    uint8_t *changed_old = fs_calloc((size_t)n_tris0 + 1, 1);
+    int32_t *list = fs_malloc((size_t)(n ? n : 1) * sizeof *list);
+    memcpy(list, elems, (size_t)n * sizeof *list);
+    int32_t n_list = n;
+    fs_refine_change ch = {0};
+    while (n_list > 0) {
+        if (fs_refine_bisect(w->mesh, list, n_list, min_size, &ch) < 0) {
+            free(list);
+            free(changed_old);
+            fs_refine_change_free(&ch);
+            return -1;
+        }
+        if (ch.n_bisections == 0)
+            break;
+        *bisected += ch.n_bisections;
+        grow_arrays(w, w->mesh->n_nodes, w->mesh->n_tris);
+        for (int32_t q = 0; q < ch.n_new_nodes; q++) {
+            int32_t i = ch.n_nodes_before + q;
+            w->thickness_factor[i] =
+                0.5 * (w->thickness_factor[ch.node_parent[2 * q]] + w->thickness_factor[ch.node_parent[2 * q + 1]]);
+        }
+        for (int32_t q = 0; q < ch.n_new_tris; q++) {
+            int32_t e = ch.n_tris_before + q, parent = ch.tri_parent[q];
+            w->state[e] = w->state[parent];
+            w->young[e] = w->young[parent];
+            w->threshold[e] = w->threshold[parent];
+        }
+        for (int32_t q = 0; q < ch.n_changed_tris; q++)
+            if (ch.changed_tri[q] < n_tris0)
+                changed_old[ch.changed_tri[q]] = 1;
+        if (!to_min_size)
+            break;
+        /* the next level: the listed triangles' descendants still at or above min_size */
+        uint8_t *flag = fs_calloc((size_t)w->n_elems, 1);
+        int32_t *next = fs_malloc(((size_t)n_list + ch.n_new_tris + 1) * sizeof *next);
+        int32_t m = descendants(&ch, list, n_list, flag, next), kept = 0;
+        free(flag);
+        for (int32_t q = 0; q < m; q++)
+            if (fs_refine_tri_size(w->mesh, next[q]) >= min_size)
+                next[kept++] = next[q];
+        free(list);
+        list = next;
+        n_list = kept;
+    }
+    free(list);
+    fs_refine_change_free(&ch);
+    if (*bisected == 0) {
+        free(changed_old);
+        return 0;
+    }
+    w->counters.subdivisions += *bisected;
+    number_dofs(w);
+    build_node_elems(w);
+    int32_t n_changed = 0;
+    int32_t *changed = fs_malloc(((size_t)w->n_elems + 1) * sizeof *changed);
+    for (int32_t e = 0; e < n_tris0; e++)
+        if (changed_old[e])
+            changed[n_changed++] = e;
+    for (int32_t e = n_tris0; e < w->n_elems; e++)
+        changed[n_changed++] = e;
+    free(changed_old);
+    int32_t *nodes = fs_malloc(3 * (size_t)(n_changed ? n_changed : 1) * sizeof *nodes);
+    for (int32_t q = 0; q < n_changed; q++)
+        for (int c = 0; c < 3; c++)
+            nodes[3 * q + c] = w->mesh->tri[3 * (size_t)changed[q] + c];
+    int rc = extend_system(w, n_free_old, n_fixed_old, changed, n_changed);
+    if (rc == 0)
+        rc = update_region(w, nodes, 3 * n_changed);
+    if (rc == 0)
+        rc = refresh_cache(w, changed, n_changed);
+    free(changed);
+    free(nodes);
+    w->counters.assemble_seconds += fs_seconds() - t0;
+    if (rc < 0)
+        return -1;
+    return factorize(w, true);
+}
+
+int fs_wedge_refactor(fs_wedge_model *w)
+{
+    return factorize(w, false);
+}

@@ -1,0 +1,221 @@
+/* The wedge finite element model (thesis ch. 5): a layer of 6-node wedges bonded to a growing background, its sparse equilibrium, and fracture by element removal with dynamic subdivision (§5.6). */
+#ifndef FS_MODEL_WEDGE_H
+#define FS_MODEL_WEDGE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "field/growth.h"
+#include "geom/mesh.h"
+#include "render/render.h"
+#include "sim/config.h"
+#include "sim/sim.h"
+#include "solve/sparse.h"
+
+/* design: every triangle of the surface mesh is extruded into one wedge (thesis §5.2): its bottom
+ * nodes are attached to the background and fixed, its top nodes are free. Mesh node i carries a
+ * bottom node and a top node, so neighbouring wedges share nodes and the layer is conforming.
+ *
+ * Frames. Plane and cylinder are simulated flat, in the unwrapped rectangle of the domain: x and y
+ * are the first two domain coordinates (cm; on the cylinder the arc length around the trunk and the
+ * height along it) and z points up, away from the background; wedges that straddle a periodic seam
+ * use the mesh's corner shifts, so the one set of nodes wraps and so does the linear system. The
+ * cylinder is therefore treated as a thin layer (curvature neglected, h / R small) whose growth
+ * around the axis is the equivalent eigenstrain below. The sphere is simulated in 3-D: a top node
+ * sits on the outward normal of its bottom node (fs_domain_normal) at the local thickness.
+ *
+ * Growth (thesis §3.3.1). Non-periodic plane and sphere: the fixed bottom nodes move along the
+ * background's flow (fs_growth_flow), which loads the layer through the coupling between fixed and
+ * free nodes. Periodic plane and cylinder: moving the nodes would break the periodic identification,
+ * so the layer takes the equivalent eigenstrain -(F - I) instead (fs_growth_strain; equal stresses in
+ * linear elasticity) and the bottom nodes stay where they are.
+ *
+ * Shrinkage (thesis §3.3.2, Fig. 3.10): the reference shape of a wedge at time t scales its bottom
+ * triangle about the bottom centroid by scale[0], its top triangle about the top centroid by
+ * scale[1], and the centroid-to-centroid height by scale[2] (fs_shrink_scales). Linearised (small
+ * strain, as everywhere in the model), the element force is K_e (u_e - u0_e) with u0_e the
+ * displacement from the original wedge to its reference shape; u0_e is linear in (scale - 1), so the
+ * global load is a fixed combination of three load vectors assembled once.
+ *
+ * So while the mesh does not change, the stiffness matrix does not change either: growth and
+ * shrinkage only change the right-hand side, and one Cholesky factor serves every equilibrium.
+ * Exception: a thickness that changes over time (thickness_final) changes the geometry, and the
+ * system is then re-assembled and re-factored (symbolic analysis kept) whenever the time changes.
+ *
+ * Units: lengths cm, E in MPa, stresses MPa (the preset's kPa threshold is converted), forces
+ * MPa cm^2. Voigt order and stress conventions as in model/wedge_element.h. */
+
+/* Unit load patterns per element: three of shrinkage, three of eigenstrain (see wedge.c). */
+#define FS_WEDGE_PATTERNS 6
+
+/* How an element left the model. */
+typedef enum { FS_WEDGE_ALIVE = 0, FS_WEDGE_REMOVED = 1 } fs_wedge_state;
+
+/* How background growth loads the layer (see the design note). */
+typedef enum { FS_WEDGE_GROWTH_NONE = 0, FS_WEDGE_GROWTH_MOVE, FS_WEDGE_GROWTH_EIGENSTRAIN } fs_wedge_growth_mode;
+
+/* Counters and timings of the solver, for logs and benchmarks. */
+typedef struct {
+    int64_t solves;           /* equilibrium solves */
+    int64_t cg_iterations;    /* summed over CG solves */
+    int64_t analyses;         /* symbolic analyses (a new pattern: first assembly, subdivision) */
+    int64_t factorizations;   /* numeric factorizations */
+    int64_t updowns;          /* rank updates of the factor after an element removal */
+    int64_t removals;         /* elements removed (fractures) */
+    int64_t subdivisions;     /* elements subdivided instead of removed (Algorithm 8) */
+    double assemble_seconds, analyze_seconds, factor_seconds, update_seconds, solve_seconds,
+        stress_seconds;
+} fs_wedge_counters;
+
+/* The whole state of one layer. Arrays are flat and indexed by mesh node or mesh triangle (one wedge
+ * per triangle); the model owns all of them except the mesh. */
+typedef struct {
+    fs_mesh *mesh;               /* borrowed, must outlive the model; subdivision refines it in place */
+    fs_config cfg;               /* copy of the configuration the model was built from */
+    fs_growth_field growth;      /* the resolved background growth */
+    fs_wedge_growth_mode growth_mode;
+    bool flat;                   /* plane or cylinder (unwrapped frame); false on the sphere */
+    double d_unit[36];           /* the elasticity matrix for E = 1 (scaled by each element's E) */
+    double time;                 /* time of the current equilibrium */
+    double shrink_coef[3];       /* at that time: scale - 1 of the reference shapes (fs_shrink_scales) */
+    double eigenstrain[3];       /* at that time: the growth eigenstrain xx, yy, xy (eigenstrain mode) */
+
+    /* Nodes: mesh node i has a bottom node and a top node; "node DOF" 6 i + k is component k of the
+     * bottom node (k < 3) or of the top node (k >= 3). */
+    int32_t n_nodes;
+    double *normal;              /* 3 per node: unit extrusion direction (flat frames: +z) */
+    double *thickness_factor;    /* per node: thickness map and gradient factor (times the thickness at t) */
+    uint8_t *pinned;             /* per node: 1 if its top node is prescribed too (patch tests), else 0 */
+    double *prescribed;          /* 6 per node: prescribed displacement of fixed DOFs besides growth (cm) */
+    double *u;                   /* 6 per node: displacement at the current equilibrium (cm) */
+    int32_t *node_elem_start;    /* n_nodes + 1: elements using each node (CSR, ascending, dead ones too) */
+    int32_t *node_elem_count;    /* per node: entries used in node_elem from node_elem_start[i] */
+    int32_t *node_elem;
+
+    /* Elements. */
+    int32_t n_elems;
+    uint8_t *state;              /* fs_wedge_state per element */
+    double *young;               /* per element: Young's modulus (MPa), with the map */
+    double *threshold;           /* per element: threshold stress (MPa), with the map and jitter */
+    double *ratio;               /* per element, at the current equilibrium: the largest principal
+                                    stress at the three top Gauss points over the threshold, or an
+                                    upper bound of it; exact for the largest ratio and every ratio that
+                                    ties with it when that is over 1 (what fracture decides on, see
+                                    wedge.c); NaN when not alive. fs_wedge_element_ratio is exact. */
+    double *stress_top;          /* 18 per element: Voigt stress (MPa) at the top Gauss points 0..2 */
+    double *gauss_cache;         /* 108 per element: geometry terms of the stress check (wedge.c) */
+
+    /* Global system: DOFs numbered free first (0 .. n_free - 1), then fixed. */
+    int32_t n_free, n_fixed;
+    int32_t *dof;                /* 6 per node: index of each node DOF in that numbering */
+    int32_t *fixed_node_dof;     /* n_fixed: the node DOF (6 i + k) of each fixed index */
+    fs_sparse_matrix k_all;      /* upper CSC of order n_free + n_fixed: the free-free block in the
+                                    leading columns, the free-fixed coupling in the others (no
+                                    fixed-fixed entries) */
+    fs_sparse_matrix k_free;     /* a view of k_all's leading n_free columns (shares its arrays) */
+    double *load;                /* 6 * n_free: unit loads; 0..2 shrinkage (per unit of scale - 1),
+                                    3..5 eigenstrain xx, yy, xy (per unit of eigenstrain) */
+    double *rhs, *x;             /* n_free each: the right-hand side and the free displacements */
+    double *u_fixed;             /* n_fixed: displacement of the fixed DOFs */
+    uint8_t *mark;               /* n_free + n_fixed scratch flags, all 0 between calls */
+    double assembled_thickness;  /* base thickness (cm) the system was assembled with */
+    fs_cholesky *chol;           /* the factor of k_free (CHOLMOD), NULL with CG */
+    int32_t updowns_pending;     /* rank updates applied since the last numeric factorization */
+
+    int64_t fractures;           /* elements removed so far */
+    fs_wedge_counters counters;
+} fs_wedge_model;
+
+/* Builds the model on mesh (borrowed, kept by pointer; its edges and rings must be built, as
+ * fs_delaunay does) with cfg's domain, material, growth, shrinkage, time, solver and wedge settings,
+ * assembles the system and, with CHOLMOD, analyses and factorizes it. Time starts at 0 with no
+ * equilibrium computed (call fs_wedge_equilibrium). Threshold jitter uses cfg->preset.seed.
+ * Returns 0, or -1 with fs_error: FS_ERR_DATA for bad parameters (growth unsuitable for the domain,
+ * E or nu out of range, a degenerate element), FS_ERR_NOINPUT for a missing map image,
+ * FS_ERR_INTERNAL if the factorization fails. On failure the model is freed. */
+int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg);
+
+/* Releases everything the model owns (not the mesh) and zeroes it. */
+void fs_wedge_free(fs_wedge_model *w);
+
+/* Prescribes the top nodes with pinned[i] != 0 (n_nodes flags) as fixed too, with the displacement
+ * in w->prescribed[6 i + 3 .. 6 i + 5]; bottom nodes are always fixed, at w->prescribed[6 i .. 6 i + 2]
+ * plus the growth motion. Re-assembles the system. For patch tests and boundary conditions.
+ * Returns 0 or -1 with fs_error. */
+int fs_wedge_pin_top(fs_wedge_model *w, const uint8_t *pinned);
+
+/* Brings the model to time t (growth, shrinkage, thickness) and solves for equilibrium: fills w->u,
+ * w->stress_top and w->ratio, sets w->time = t. Returns 0, or -1 with fs_error(FS_ERR_INTERNAL) if
+ * the solver fails (CG not converging, factorization not positive definite) or FS_ERR_DATA if an
+ * element degenerates. */
+int fs_wedge_equilibrium(fs_wedge_model *w, double t);
+
+/* The largest w->ratio over the living elements (-inf if none): exact when it is over 1, else an
+ * upper bound that is itself at most 1. */
+double fs_wedge_max_ratio(const fs_wedge_model *w);
+
+/* The exact ratio of element e's largest principal stress at its top Gauss points to its threshold,
+ * at the current equilibrium (NaN if e is not alive or the eigen kernel fails). */
+double fs_wedge_element_ratio(const fs_wedge_model *w, int32_t e);
+
+/* Element geometry at the current time: x[18] node coordinates in the model's frame (bottom nodes
+ * 0..2, top 3..5, see wedge_element.h), unwrapped across periodic seams. */
+void fs_wedge_element_coords(const fs_wedge_model *w, int32_t e, double x[18]);
+
+/* Stress (Voigt, MPa) of a living element at natural point (r, s, zeta), at the current equilibrium,
+ * net of the shrinkage reference shape and growth eigenstrain. Returns 0 or -1 with fs_error. */
+int fs_wedge_element_stress(const fs_wedge_model *w, int32_t e, double r, double s, double zeta, double stress[6]);
+
+/* Nodal stress of the top (top = true) or bottom node of mesh node i (thesis §5.7.1): the average over
+ * the living elements around the node of the stress at each element's Gauss point nearest the node.
+ * Requires the mesh rings. Returns the number of elements averaged (0: stress zeroed), or -1. */
+int fs_wedge_nodal_stress(const fs_wedge_model *w, int32_t node, bool top, double stress[6]);
+
+/* One fracture event at the current time (thesis §5.6.2-5.6.4, Algorithm 8): picks the living
+ * element with the largest ratio over 1 (fs_rank_pick, ties by the seed). If its longest edge
+ * (fs_refine_tri_size) is at least mesh.min_size, it and every other element over its threshold and
+ * at least that size are bisected (Rivara, Algorithm 9) until they are below it, and nothing is
+ * removed; otherwise it is removed and the global system updated in place (Algorithm 7), the factor by
+ * a low-rank downdate or a re-factorization. Does not re-solve. *removed is set to 1 for a removal, 0
+ * for a subdivision. Returns 0, 1 if no element is over its threshold (nothing done), or -1 with
+ * fs_error. */
+int fs_wedge_fracture(fs_wedge_model *w, int *removed);
+
+/* Removes element e (alive) and updates the system as fs_wedge_fracture does. Returns 0 or -1. */
+int fs_wedge_remove(fs_wedge_model *w, int32_t e);
+
+/* Bisects the listed elements (fs_refine_bisect with cfg.mesh.min_size, conforming, so neighbours may
+ * be bisected too); with to_min_size, bisects their descendants again until every one is below
+ * min_size. Extends the node and element arrays (new nodes interpolate the thickness factor of their
+ * edge, new elements inherit their parent's state and materials), updates the global system for the
+ * changed elements only (the other entries are kept), then re-analyses and re-factorizes once.
+ * *bisected receives the number of triangles bisected (0: nothing changed, all were below min_size).
+ * Returns 0 or -1 with fs_error. */
+int fs_wedge_subdivide(fs_wedge_model *w, const int32_t *elems, int32_t n, bool to_min_size, int32_t *bisected);
+
+/* Re-factorizes the current matrix now (CHOLMOD; nothing with CG), dropping accumulated updates.
+ * Returns 0 or -1 with fs_error. */
+int fs_wedge_refactor(fs_wedge_model *w);
+
+/* Runs the model from its current time to t_end (thesis Algorithms 1, 5 and 8): equilibrium,
+ * fracture events while an element is over its threshold, otherwise the adaptive time step to the
+ * next event (fs_event_find, resolution cfg.time.min_step). Progress through fs_progress. Returns 0
+ * or -1 with fs_error. */
+int fs_wedge_simulate(fs_wedge_model *w, double t_end);
+
+/* The render mesh of the current state (SPEC §6, texture space, see render.h): the top surface of the
+ * living elements (height = top of the layer in cm, crack 0, cell = connected fragment + 1 (wrapping
+ * past 65535), shade per fragment) and the floor of removed elements (height 0, crack 1, cell 0).
+ * Fragments are the connected components of living elements sharing a node. Returns 0 or -1. */
+int fs_wedge_render_mesh(const fs_wedge_model *w, fs_render_mesh *out);
+
+/* Fragment label of every element (-1 for removed ones, else 0 .. count-1 numbered by their smallest
+ * element); returns the count. labels has n_elems entries. */
+int32_t fs_wedge_fragments(const fs_wedge_model *w, int32_t *labels);
+
+/* The whole wedge run of fs_sim_run: model on mesh (refined in place by subdivision), simulation to
+ * cfg->time.end, render mesh into surface; stats gets fractures and the simulated time (nodes,
+ * elements and timings are the caller's). Returns 0 or -1 with fs_error. */
+int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, fs_stats *stats);
+
+#endif

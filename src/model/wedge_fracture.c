@@ -1,0 +1,154 @@
+/* The wedge model's fracture loop: element selection, removal or subdivision (Algorithm 8), adaptive time steps to the next event (Algorithm 5), and the run of fs_sim_run. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "base/log.h"
+#include "fracture/event.h"
+#include "fracture/rank.h"
+#include "geom/refine.h"
+#include "model/wedge.h"
+
+/* Candidates of one subdivision batch, sorted by descending ratio, then ascending index. */
+typedef struct {
+    double ratio;
+    int32_t e;
+} candidate;
+
+static int cmp_candidate(const void *a, const void *b)
+{
+    const candidate *x = a, *y = b;
+    if (x->ratio != y->ratio)
+        return x->ratio < y->ratio ? 1 : -1;
+    return (x->e > y->e) - (x->e < y->e);
+}
+
+/* design: thesis Algorithm 8. The element that breaks is the one with the largest ratio of stress to
+ * threshold (ties by the seed, fracture/rank.h). If it is not yet below mesh.min_size, it is subdivided
+ * instead of removed, and the model relaxes again before anything breaks. Two departures, both for
+ * the cost of re-analysing the sparse pattern after every change of the mesh: every other element over
+ * its threshold and not below min_size is bisected in the same call, and the bisection goes on to the
+ * descendants until all are below min_size (Algorithm 8 relaxes after each single bisection).
+ * Subdivision refines the discretisation, not the material, and these elements sit where the next
+ * fractures are about to happen, so the pattern is the same kind; one analysis replaces several. */
+int fs_wedge_fracture(fs_wedge_model *w, int *removed)
+{
+    *removed = 0;
+    if (!(fs_wedge_max_ratio(w) > 1.0))
+        return 1;
+    int32_t pick = fs_rank_pick(w->ratio, NULL, w->n_elems, w->cfg.preset.seed);
+    FS_ASSERT(pick >= 0);
+    double min_size = w->cfg.mesh.min_size;
+    if (fs_refine_tri_size(w->mesh, pick) >= min_size) {
+        candidate *c = fs_malloc((size_t)w->n_elems * sizeof *c);
+        int32_t n = 0;
+        for (int32_t e = 0; e < w->n_elems; e++)
+            if (w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0 && fs_refine_tri_size(w->mesh, e) >= min_size) {
+                double r = fs_wedge_element_ratio(w, e);
+                if (r > 1.0)
+                    c[n++] = (candidate){r, e};
+            }
+        qsort(c, (size_t)n, sizeof *c, cmp_candidate);
+        int32_t *list = fs_malloc((size_t)(n + 1) * sizeof *list);
+        list[0] = pick;
+        int32_t m = 1;
+        for (int32_t q = 0; q < n; q++)
+            if (c[q].e != pick)
+                list[m++] = c[q].e;
+        free(c);
+        int32_t bisected = 0;
+        int rc = fs_wedge_subdivide(w, list, m, true, &bisected);
+        free(list);
+        if (rc < 0)
+            return -1;
+        if (bisected > 0)
+            return 0;
+    }
+    if (fs_wedge_remove(w, pick) < 0)
+        return -1;
+    *removed = 1;
+    return 0;
+}
+
+static double event_ratio(void *ctx, double t)
+{
+    fs_wedge_model *w = ctx;
+    if (fs_wedge_equilibrium(w, t) < 0)
+        return NAN;
+    return fs_wedge_max_ratio(w);
+}
+
+static void report(const fs_wedge_model *w, double t_end)
+{
+    fs_progress("wedge", t_end > 0.0 ? w->time / t_end : -1.0, "t = %.4g, %lld fractures, %d elements",
+                w->time, (long long)w->fractures, (int)w->n_elems);
+}
+
+/* design: thesis Algorithm 1 with Algorithms 5 and 8. At the current time the model is relaxed; while
+ * some element is over its threshold, one fracture event happens (removal or subdivision) and the
+ * model relaxes again at the same time, so cracks run as far as the stresses drive them. When nothing
+ * is over its threshold, fs_event_find advances to just past the next time something is (within
+ * time.min_step), starting with a step of half the time since the previous event. */
+int fs_wedge_simulate(fs_wedge_model *w, double t_end)
+{
+    double min_step = w->cfg.time.min_step;
+    if (fs_wedge_equilibrium(w, w->time) < 0)
+        return -1;
+    double last_event = w->time, dt_trial = fmax(min_step, (t_end - w->time) / 32.0);
+    for (;;) {
+        while (fs_wedge_max_ratio(w) > 1.0) {
+            int removed;
+            int rc = fs_wedge_fracture(w, &removed);
+            if (rc < 0)
+                return -1;
+            if (rc == 1)
+                break;
+            if (fs_wedge_equilibrium(w, w->time) < 0)
+                return -1;
+            report(w, t_end);
+        }
+        if (w->time >= t_end)
+            break;
+        fs_event_result r;
+        if (fs_event_find(event_ratio, w, w->time, dt_trial, t_end, min_step, &r) < 0)
+            return -1;
+        if (r.t_last != r.t && fs_wedge_equilibrium(w, r.t) < 0)
+            return -1;
+        report(w, t_end);
+        if (!r.found)
+            break;
+        dt_trial = fmax(min_step, 0.5 * (r.t - last_event));
+        last_event = r.t;
+    }
+    return 0;
+}
+
+int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, fs_stats *stats)
+{
+    if (cfg->fracture.method != FS_FRACTURE_REMOVE) {
+        fs_error(FS_ERR_DATA, "[fracture] method: the wedge model fractures by element removal; expected remove, "
+                 "got split");
+        return -1;
+    }
+    fs_wedge_model w;
+    if (fs_wedge_init(&w, mesh, cfg) < 0)
+        return -1;
+    int rc = fs_wedge_simulate(&w, cfg->time.end);
+    if (rc == 0)
+        rc = fs_wedge_render_mesh(&w, surface);
+    if (rc == 0) {
+        const fs_wedge_counters *c = &w.counters;
+        stats->fractures = w.fractures;
+        stats->simulated_time = w.time;
+        fs_debug("wedge: %lld removals, %lld subdivisions, %lld solves (%.2f s), %lld factorizations (%.2f s), "
+                 "%lld analyses (%.2f s), %lld updates (%.2f s), assembly %.2f s, stresses %.2f s, "
+                 "%lld CG iterations",
+                 (long long)c->removals, (long long)c->subdivisions, (long long)c->solves, c->solve_seconds,
+                 (long long)c->factorizations, c->factor_seconds, (long long)c->analyses, c->analyze_seconds,
+                 (long long)c->updowns, c->update_seconds, c->assemble_seconds, c->stress_seconds,
+                 (long long)c->cg_iterations);
+    }
+    fs_wedge_free(&w);
+    return rc;
+}
