@@ -56,6 +56,11 @@ static int cmp_edge(const void *x, const void *y)
     return a->f < b->f ? -1 : (a->f > b->f);
 }
 
+static double dist2(const double *a, const double *b)
+{
+    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+}
+
 static int32_t find(int32_t *parent, int32_t i)
 {
     while (parent[i] != i)
@@ -143,7 +148,8 @@ static int same_border(const domain *d, const double *p, const double *q)
         return 0;
     }
     if (d->type == 1)
-        return (fabs(p[2]) <= d->tol && fabs(q[2]) <= d->tol) || (fabs(p[2] - d->h) <= d->tol && fabs(q[2] - d->h) <= d->tol);
+        return (fabs(p[2]) <= d->tol && fabs(q[2]) <= d->tol) ||
+               (fabs(p[2] - d->h) <= d->tol && fabs(q[2] - d->h) <= d->tol);
     return 0;
 }
 
@@ -252,7 +258,7 @@ int main(int argc, char **argv)
     for (int32_t i = 0; i < np; i++)
         for (int32_t j = i + 1; j < np && pos[3 * order[j]] - pos[3 * order[i]] <= weld; j++) {
             const double *a = pos + 3 * order[i], *b = pos + 3 * order[j];
-            double dd = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+            double dd = sqrt(dist2(a, b));
             if (dd <= weld)
                 fail("positions %g apart are not welded (at x = %g)", dd, a[0]);
         }
@@ -274,7 +280,7 @@ int main(int argc, char **argv)
                 double longest2 = 0.0;
         for (int k = 0; k < 3; k++) {
             const double *p0 = p[k], *p1 = p[(k + 1) % 3];
-            double l2 = (p1[0] - p0[0]) * (p1[0] - p0[0]) + (p1[1] - p0[1]) * (p1[1] - p0[1]) + (p1[2] - p0[2]) * (p1[2] - p0[2]);
+            double l2 = dist2(p0, p1);
             longest2 = l2 > longest2 ? l2 : longest2;
         }
         for (int k = 0; k < 3; k++) {
@@ -285,7 +291,8 @@ int main(int argc, char **argv)
         }
         /* triangles with no area in texture space (upright slivers along a border) face sideways */
         const float *t0 = uv + 2 * x->t[0], *t1 = uv + 2 * x->t[1], *t2 = uv + 2 * x->t[2];
-        double uv_area2 = fabs(((double)t1[0] - t0[0]) * ((double)t2[1] - t0[1]) - ((double)t1[1] - t0[1]) * ((double)t2[0] - t0[0]));
+        double uv_area2 =
+            fabs(((double)t1[0] - t0[0]) * ((double)t2[1] - t0[1]) - ((double)t1[1] - t0[1]) * ((double)t2[0] - t0[0]));
         /* needles (width below 1% of their length) have no meaningful facing */
         /* nor do triangles touching a pole of the sphere, where the texture map is singular */
         int at_pole = 0;

@@ -177,9 +177,9 @@ static int32_t weld_search(welder *w, const double *x)
     for (int dz = 0; dz <= (side[2] != 0); dz++)
         for (int dy = 0; dy <= (side[1] != 0); dy++)
             for (int dx = 0; dx <= (side[0] != 0); dx++) {
-                const int32_t *head =
-                    imap_find(&w->grid, cell_key(wrap_cell(w, 0, c[0] + dx * side[0]), wrap_cell(w, 1, c[1] + dy * side[1]),
-                                                 wrap_cell(w, 2, c[2] + dz * side[2])));
+                uint64_t key = cell_key(wrap_cell(w, 0, c[0] + dx * side[0]), wrap_cell(w, 1, c[1] + dy * side[1]),
+                                        wrap_cell(w, 2, c[2] + dz * side[2]));
+                const int32_t *head = imap_find(&w->grid, key);
                 for (int32_t i = head ? *head : -1; i >= 0; i = w->next[i]) {
                     const double *p = w->p + 3 * (size_t)i;
                     double e2 = 0.0;
@@ -283,7 +283,7 @@ static int32_t dedup_add(dedup *d, const float *x)
 /* ---- the lift ---- */
 
 /* A point of texture space with its height, and its canonical id: points that are one point of
- * the layer (up to rounding, in any period) share an id. */
+ * the texture (up to rounding, in any period) share an id, whatever their heights. */
 typedef struct {
     double u, v, h;
     int32_t id;
@@ -296,7 +296,7 @@ typedef struct {
 
 /* A point where an edge meets a line of the texture square's grid, as first computed. */
 typedef struct {
-    double along, h; /* the coordinate along the line, and the height */
+    double along, t; /* the coordinate along the line, and the parameter from the lower-id end */
     int32_t id;
 } cut_point;
 
@@ -305,8 +305,10 @@ typedef struct {
     double scale;
     bool wrap[2];
     double ext[2];       /* extents of the texture square in cm, for the canonical weld */
-    welder canon;        /* canonical points: (u ext_x, v ext_y, h), periodic on wrapping axes */
-    imap cut_map[2];     /* (lower id, higher id) of an edge -> its cut by a line of constant u / v */
+    welder canon;        /* canonical points: (u ext_x, v ext_y, 0), periodic on wrapping axes */
+    imap cut_map[4];     /* (lower id, higher id) of an edge -> its cut by a line of constant u (0, 1)
+                          * or v (2, 3); on a wrapping axis every line is one (0 or 2), on another
+                          * the lines 0 and 1 differ */
     cut_point *cuts;
     int32_t n_cuts, cap_cuts;
     welder pos, base;
@@ -320,19 +322,21 @@ typedef struct {
 
 static double coord(const uvh *p, int axis) { return axis ? p->v : p->u; }
 
-static int32_t canonical_id(lift_ctx *c, double u, double v, double h)
+static int32_t canonical_id(lift_ctx *c, double u, double v)
 {
-    double x[3] = {u * c->ext[0], v * c->ext[1], h};
+    double x[3] = {u * c->ext[0], v * c->ext[1], 0.0};
     return weld(&c->canon, x);
 }
 
 /* design: an edge that crosses a seam is cut there by both of its triangles, which may hold its
  * ends in different periods (u and u + 1 differ in float); computed twice, the two cuts would
  * miss each other by rounding magnified by the edge's slope. So the first computation of the cut of
- * an edge (named by its ends' canonical ids) is kept and reused, shifted into the caller's period;
- * cut points get canonical ids too, so the second clipping axis cuts the new edges consistently.
- * Cuts interpolate in texture space, as the renderer does, so the lifted pieces show what the maps
- * show. */
+ * an edge of the texture (named by its ends' canonical ids) is kept and reused, shifted into the
+ * caller's period; cut points get canonical ids too, so the second clipping axis cuts the new edges
+ * consistently. Edges over the same segment of the texture at different heights (the two sides of
+ * a step) share the cut too, with their own heights interpolated, so their cut points stay one
+ * above the other and the step is still closed by a wall. Cuts interpolate in texture space, as
+ * the renderer does, so the lifted pieces show what the maps show. */
 static uvh cut(lift_ctx *c, const uvh *a, const uvh *b, int axis, double line)
 {
     if (b->id < a->id || (b->id == a->id && coord(b, axis) < coord(a, axis))) {
@@ -342,10 +346,11 @@ static uvh cut(lift_ctx *c, const uvh *a, const uvh *b, int axis, double line)
     }
     double da = coord(a, axis), db = coord(b, axis);
     double t = db != da ? (line - da) / (db - da) : 0.0;
-    uvh x = {a->u + t * (b->u - a->u), a->v + t * (b->v - a->v), a->h + t * (b->h - a->h), -1};
+    uvh x = {a->u + t * (b->u - a->u), a->v + t * (b->v - a->v), 0.0, -1};
     double *along = axis ? &x.u : &x.v;
     bool found;
-    int32_t *slot = imap_get(&c->cut_map[axis], pair_key(a->id, b->id), c->n_cuts, &found);
+    int map = 2 * axis + (!c->wrap[axis] && line > 0.5);
+    int32_t *slot = imap_get(&c->cut_map[map], pair_key(a->id, b->id), c->n_cuts, &found);
     if (!found) {
         if (c->n_cuts == c->cap_cuts) {
             c->cap_cuts = c->cap_cuts ? 2 * c->cap_cuts : 256;
@@ -355,15 +360,16 @@ static uvh cut(lift_ctx *c, const uvh *a, const uvh *b, int axis, double line)
             x.v = line;
         else
             x.u = line;
-        x.id = canonical_id(c, x.u, x.v, x.h);
-        c->cuts[c->n_cuts++] = (cut_point){*along, x.h, x.id};
+        x.id = canonical_id(c, x.u, x.v);
+        c->cuts[c->n_cuts++] = (cut_point){*along, t, x.id};
     } else {
         const cut_point *k = c->cuts + *slot;
         double shift = c->wrap[1 - axis] ? round(*along - k->along) : 0.0;
         *along = k->along + shift;
-        x.h = k->h;
+        t = k->t;
         x.id = k->id;
     }
+    x.h = a->h + t * (b->h - a->h);
     if (axis)
         x.v = line;
     else
@@ -469,7 +475,7 @@ static void emit_triangle(lift_ctx *c, uvh *v, const int32_t *src)
         }
     }
     for (int i = 0; i < 3; i++)
-        v[i].id = canonical_id(c, v[i].u, v[i].v, v[i].h);
+        v[i].id = canonical_id(c, v[i].u, v[i].v);
     for (int ku = k_lo[0]; ku <= k_hi[0]; ku++)
         for (int kv = k_lo[1]; kv <= k_hi[1]; kv++) {
             uvh a[16], b[16];
@@ -493,7 +499,7 @@ static void emit_triangle(lift_ctx *c, uvh *v, const int32_t *src)
 typedef struct {
     int32_t a, b;      /* a < b */
     int32_t face[2];
-    int8_t side[2];    /* corner of the edge's first end in each face */
+    int8_t side[2];    /* per face: the corner k where the edge runs from corner k to k + 1 */
     int32_t count;
 } edge_rec;
 
@@ -613,7 +619,8 @@ static int32_t drop_coincident(lift_ctx *c)
 /* Twice the signed area of triangle t in texture space. */
 static double uv_area2(const lift_ctx *c, const tri *t)
 {
-    const float *a = c->uv.v + 2 * (size_t)t->uv[0], *b = c->uv.v + 2 * (size_t)t->uv[1], *d = c->uv.v + 2 * (size_t)t->uv[2];
+    const float *a = c->uv.v + 2 * (size_t)t->uv[0], *b = c->uv.v + 2 * (size_t)t->uv[1];
+    const float *d = c->uv.v + 2 * (size_t)t->uv[2];
     return ((double)b[0] - a[0]) * ((double)d[1] - a[1]) - ((double)b[1] - a[1]) * ((double)d[0] - a[0]);
 }
 
@@ -871,7 +878,8 @@ static void build_normals(const lift_ctx *c, fs_lifted_mesh *out)
      * the normals its corners got so far */
     float *normals = fs_malloc((3 * (size_t)n_t + 1) * 3 * sizeof *normals);
     int32_t n_normals = 0;
-    int32_t *first = fs_malloc(((size_t)n_p + 1) * sizeof *first), *next = fs_malloc((3 * (size_t)n_t + 1) * sizeof *next);
+    int32_t *first = fs_malloc(((size_t)n_p + 1) * sizeof *first);
+    int32_t *next = fs_malloc((3 * (size_t)n_t + 1) * sizeof *next);
     for (int32_t i = 0; i < n_p; i++)
         first[i] = -1;
     for (int32_t f = 0; f < n_t; f++) {
@@ -951,8 +959,8 @@ int fs_render_mesh_lift(const fs_render_mesh *m, const fs_domain *dom, double he
     double tol = weld_fraction * size;
     double period[3] = {c.wrap[0] ? c.ext[0] : 0.0, c.wrap[1] ? c.ext[1] : 0.0, 0.0};
     welder_init(&c.canon, tol, period, (size_t)m->n_verts);
-    imap_init(&c.cut_map[0], 64);
-    imap_init(&c.cut_map[1], 64);
+    for (int k = 0; k < 4; k++)
+        imap_init(&c.cut_map[k], 64);
     welder_init(&c.pos, tol, NULL, (size_t)m->n_verts);
     welder_init(&c.base, tol, NULL, (size_t)m->n_verts);
     dedup_init(&c.uv, 2, (size_t)m->n_verts);
@@ -992,8 +1000,8 @@ int fs_render_mesh_lift(const fs_render_mesh *m, const fs_domain *dom, double he
     c.pos.p = NULL;
 
     welder_free(&c.canon);
-    imap_free(&c.cut_map[0]);
-    imap_free(&c.cut_map[1]);
+    for (int k = 0; k < 4; k++)
+        imap_free(&c.cut_map[k]);
     free(c.cuts);
     welder_free(&c.pos);
     welder_free(&c.base);
@@ -1018,7 +1026,7 @@ void fs_lifted_mesh_free(fs_lifted_mesh *l)
     memset(l, 0, sizeof *l);
 }
 
-int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges)
+int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges, int32_t *n_bad)
 {
     *edges = NULL;
     imap map;
@@ -1026,6 +1034,7 @@ int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges)
     /* per undirected edge: the directed edge of its first triangle and how many triangles use it */
     int32_t *first = fs_malloc((6 * (size_t)l->n_tris + 2) * sizeof *first);
     int32_t *count = fs_calloc(3 * (size_t)l->n_tris + 1, sizeof *count);
+    uint8_t *twice = fs_calloc(3 * (size_t)l->n_tris + 1, 1); /* run the same way by two triangles */
     int32_t n = 0, bad = 0;
     for (int32_t f = 0; f < l->n_tris; f++)
         for (int k = 0; k < 3; k++) {
@@ -1037,24 +1046,17 @@ int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges)
                 first[2 * n + 1] = b;
                 n++;
             } else if (first[2 * *slot] == a) {
-                bad++; /* the same direction twice */
+                twice[*slot] = 1;
             }
             count[*slot]++;
         }
     int32_t n_b = 0;
     for (int32_t i = 0; i < n; i++) {
-        if (count[i] > 2)
-            bad++;
+        bad += count[i] > 2 || twice[i];
         n_b += count[i] == 1;
     }
-    if (bad > 0) {
-        fs_error(FS_ERR_INTERNAL, "lift: %d edges are shared by more than two triangles or run the same way in two",
-                 (int)bad);
-        imap_free(&map);
-        free(first);
-        free(count);
-        return -1;
-    }
+    if (n_bad)
+        *n_bad = bad;
     int32_t *e = fs_malloc((2 * (size_t)n_b + 1) * sizeof *e), j = 0;
     for (int32_t i = 0; i < n; i++)
         if (count[i] == 1) {
@@ -1066,6 +1068,7 @@ int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges)
     imap_free(&map);
     free(first);
     free(count);
+    free(twice);
     return n_b;
 }
 
@@ -1073,13 +1076,15 @@ int32_t fs_lifted_mesh_vertices(const fs_lifted_mesh *l, int32_t **vert, uint32_
 {
     imap map;
     imap_init(&map, (size_t)l->n_pos);
-    int32_t *v = fs_malloc((9 * (size_t)l->n_tris + 3) * sizeof *v), *next = fs_malloc((3 * (size_t)l->n_tris + 1) * sizeof *next);
+    int32_t *v = fs_malloc((9 * (size_t)l->n_tris + 3) * sizeof *v);
+    int32_t *next = fs_malloc((3 * (size_t)l->n_tris + 1) * sizeof *next);
     uint32_t *t = fs_malloc((3 * (size_t)l->n_tris + 1) * sizeof *t);
     int32_t n = 0;
     for (size_t k = 0; k < 3 * (size_t)l->n_tris; k++) {
         const int32_t *c = l->corner + 3 * k;
         bool found;
-        int32_t *slot = imap_get(&map, mix64(mix64(mix64((uint64_t)c[0]) ^ (uint64_t)c[1]) ^ (uint64_t)c[2]), -1, &found);
+        uint64_t key = mix64(mix64(mix64((uint64_t)c[0]) ^ (uint64_t)c[1]) ^ (uint64_t)c[2]);
+        int32_t *slot = imap_get(&map, key, -1, &found);
         int32_t i = *slot;
         while (i >= 0 && memcmp(v + 3 * (size_t)i, c, 3 * sizeof *c))
             i = next[i];

@@ -482,7 +482,8 @@ int fs_osmesa_lit_load(fs_osmesa *g, const fs_osmesa_scene *s, const fs_osmesa_m
         L->counts[k] = 3 * (GLsizei)m->n_tris;
     }
     L->texture = upload_rgb(tex->width, tex->height, tex->rgb, GL_SRGB8, tex->wrap_u, tex->wrap_v);
-    L->normal_texture = upload_rgb(tex->normal_width, tex->normal_height, tex->normal, GL_RGB8, tex->wrap_u, tex->wrap_v);
+    L->normal_texture =
+        upload_rgb(tex->normal_width, tex->normal_height, tex->normal, GL_RGB8, tex->wrap_u, tex->wrap_v);
     L->normal_green_sign = tex->normal_green_sign;
     if (gl_check("uploading the lit scene") != 0 || make_targets(g, L) != 0)
         goto fail;

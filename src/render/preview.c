@@ -13,7 +13,10 @@
 /* design: the preview draws the render mesh lifted into 3-D (render/lift.c, heights times
  * height_scale), which is exactly the surface the height and normal maps were rasterised from:
  * displacing a grid by the height map instead would blur every crack wall into a ramp one texel
- * wide. The basecolor map is its texture; walls the lift added take the palette's crack colour.
+ * wide. The basecolor map is its texture and the normal map its shading normal (it carries the
+ * smooth bevels the mesh draws as fans of slivers); walls the lift added take the palette's crack
+ * colour and their own normals, except low ones, mere seams between surfaces a model drew at
+ * slightly different heights, which continue the surface around them.
  * Around it, a plane becomes a slab (its border profile extruded down to a base), a cylinder a
  * trunk segment (its ends closed by the bark's cross-section and end grain with growth rings),
  * a sphere a globe. The camera looks down at a fixed angle from the side away from the texture
@@ -75,8 +78,8 @@ static void mesh_tri(scene_mesh *m, int32_t a, int32_t b, int32_t c)
 }
 
 /* A flat quad a, b, c, d with normal n. */
-static void mesh_quad(scene_mesh *m, const double *a, const double *b, const double *c, const double *d, const double *n,
-                      const float *tint)
+static void mesh_quad(scene_mesh *m, const double *a, const double *b, const double *c, const double *d,
+                      const double *n, const float *tint)
 {
     int32_t i = mesh_vertex(m, a, n, 0.0, 0.0, tint, no_tangent), j = mesh_vertex(m, b, n, 0.0, 0.0, tint, no_tangent);
     int32_t k = mesh_vertex(m, c, n, 0.0, 0.0, tint, no_tangent), l = mesh_vertex(m, d, n, 0.0, 0.0, tint, no_tangent);
@@ -214,7 +217,7 @@ static void add_trunk_ends(scene_mesh *m, const fs_lifted_mesh *l, const int32_t
                            const fs_domain *d, const float *bark)
 {
     const int rings = 16;
-    const double wood[3] = {0.42, 0.27, 0.14};
+    const double wood[3] = {0.34, 0.21, 0.10};
     for (int32_t e = 0; e < n_edges; e++) {
         const double *a = l->pos + 3 * (size_t)edges[2 * e], *b = l->pos + 3 * (size_t)edges[2 * e + 1];
         double z = a[2], n[3] = {0.0, 0.0, z > 0.5 * d->height ? 1.0 : -1.0};
@@ -226,7 +229,8 @@ static void add_trunk_ends(scene_mesh *m, const fs_lifted_mesh *l, const int32_t
         mesh_quad(m, a, b, b_in, a_in, n, bark);
         for (int k = 0; k < rings; k++) {
             /* rings grow wider towards the bark; early and late wood alternate */
-            double r0 = d->radius * sqrt((double)(rings - k) / rings), r1 = d->radius * sqrt((double)(rings - k - 1) / rings);
+            double r0 = d->radius * sqrt((double)(rings - k) / rings);
+            double r1 = d->radius * sqrt((double)(rings - k - 1) / rings);
             double shade = (k % 2 ? 0.82 : 1.0) * (1.0 + 0.06 * sin(2.4 * k));
             float t[4] = {(float)(wood[0] * shade), (float)(wood[1] * shade), (float)(wood[2] * shade), 0.0f};
             double p0[3] = {ua[0] * r0, ua[1] * r0, z}, p1[3] = {ub[0] * r0, ub[1] * r0, z};
@@ -382,13 +386,10 @@ int fs_render_preview(const fs_render_mesh *rm, const fs_domain *dom, const fs_r
     fs_lifted_mesh l;
     if (fs_render_mesh_lift(rm, &d, p->height_scale, &l) < 0)
         return -1;
-    int32_t *edges = NULL;
-    int32_t n_edges = fs_lifted_mesh_boundary(&l, &edges);
-    if (n_edges < 0) {
-        fs_debug("preview: %s; the sides are left open", fs_error_message());
-        fs_error_clear();
-        n_edges = 0;
-    }
+    int32_t *edges = NULL, n_bad = 0;
+    int32_t n_edges = fs_lifted_mesh_boundary(&l, &edges, &n_bad);
+    if (n_bad > 0)
+        fs_debug("preview: %d edges of the lifted mesh have more than two triangles", (int)n_bad);
 
     scene_mesh layer = {0}, body = {0};
     double h_max = 0.0;
@@ -405,7 +406,7 @@ int fs_render_preview(const fs_render_mesh *rm, const fs_domain *dom, const fs_r
     double el = 0.0, az = 0.0, forward[3] = {0.0, 0.0, 0.0};
     switch (d.type) {
     case FS_DOMAIN_PLANE:
-        add_slab(&body, &l, edges, n_edges, &d, fmax(3.0 * h_max, 0.05 * fmin(d.width, d.height)), body_tint);
+        add_slab(&body, &l, edges, n_edges, &d, fmax(2.0 * h_max, 0.04 * fmin(d.width, d.height)), body_tint);
         cam.up[2] = 1.0;
         forward[1] = 1.0;
         el = 40.0;
@@ -467,7 +468,7 @@ int fs_render_preview(const fs_render_mesh *rm, const fs_domain *dom, const fs_r
         horiz[q] -= along_up * cam.up[q];
     normalize3(horiz);
     for (int q = 0; q < 3; q++)
-        light[q] = -0.62 * cam.right[q] + 0.72 * cam.up[q] - 0.30 * horiz[q];
+        light[q] = -0.55 * cam.right[q] + 0.70 * cam.up[q] - 0.45 * horiz[q];
     normalize3(light);
 
     fs_osmesa_scene scene = {

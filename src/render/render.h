@@ -119,23 +119,26 @@ typedef struct {
  * each vertex is placed at the domain point of its uv (fs_domain_from_uv, fs_domain_embed), moved
  * by height * height_scale along the outward normal: plane (u W, v H, h), cylinder and sphere at
  * radius R + h. Positions closer than 2.5e-7 of the domain's size are welded (so the cylinder and
- * sphere close across their seam and at the poles); triangles that collapse are dropped; each is
- * oriented by its area in texture space (walls with no such area take the orientation of their
- * neighbours). The render mesh draws a step between two surfaces (a crack floor beside a cell top)
- * as two boundaries over the same line in texture space; the lift closes every such step by a
- * vertical wall of two triangles, so the result is bounded only along the domain's borders:
- * the four sides of a plane (periodic or not: a tile is a flat slab in 3-D), the two ends of a
- * cylinder, nowhere on a sphere. Corner normals average, weighted by angle, the normals of the
- * triangles around the position within 50 degrees of the corner's own triangle, so walls and
- * tops keep a crisp edge. Returns 0, or -1 with fs_error(FS_ERR_INTERNAL) for a non-finite vertex. */
+ * sphere close across their seam and at the poles); triangles that collapse are dropped, and
+ * coincident ones cancel in pairs. Orientation is made consistent across shared edges, each
+ * connected piece facing the way most of its texture-space area says. The render mesh draws a step
+ * between two surfaces (a crack floor beside a cell top) as two boundaries over the same line in
+ * texture space; the lift closes every such step by a vertical wall of two triangles (and cuts the
+ * walls' upright edges where walls of different heights meet), so the result is bounded only along
+ * the domain's borders: the four sides of a plane (periodic or not: a tile is a flat slab in 3-D),
+ * the two ends of a cylinder, nowhere on a sphere. Corner normals average, weighted by angle, the
+ * normals of the triangles around the position within 50 degrees of the corner's own triangle, so
+ * walls and tops keep a crisp edge. Returns 0, or -1 with fs_error(FS_ERR_INTERNAL) for a
+ * non-finite vertex. */
 int fs_render_mesh_lift(const fs_render_mesh *m, const fs_domain *d, double height_scale, fs_lifted_mesh *out);
 void fs_lifted_mesh_free(fs_lifted_mesh *l);
 
 /* Edges (pairs of position indices) used by exactly one triangle, in the direction their triangle
- * runs along them: 2 * count entries in *edges (caller frees). Returns the count, or -1 with
- * fs_error(FS_ERR_INTERNAL) when an edge has more than two triangles or two in the same
- * direction (a non-manifold or inconsistently oriented mesh). */
-int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges);
+ * runs along them: 2 * count entries in *edges (caller frees); returns the count. *n_bad (if not
+ * NULL) gets the number of edges with more than two triangles or two running the same way: none in
+ * a manifold, consistently oriented mesh. (The lift leaves such edges where a model's surfaces
+ * meet four around one point at alternating heights, or overlap.) */
+int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges, int32_t *n_bad);
 
 /* The corners of l as vertices for drawing: one per distinct (position, texture vertex, normal),
  * *vert holding those three indices per vertex, and 3 vertex indices per triangle in *tri (caller
@@ -143,10 +146,11 @@ int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges);
 int32_t fs_lifted_mesh_vertices(const fs_lifted_mesh *l, int32_t **vert, uint32_t **tri);
 
 /* The lit perspective 3-D view of SPEC §6 (render/preview.c): the lifted render mesh (heights times
- * p->height_scale) textured with maps->basecolor, shown as a slab for a plane, a trunk segment
- * for a cylinder and a globe for a sphere, into a p->preview_width x p->preview_height RGB 8-bit
- * sRGB image (allocated into *out). Deterministic for a given mesh on a given machine. Returns 0
- * or -1 with fs_error. */
+ * p->height_scale) textured with maps->basecolor and lit through maps->normal (whose convention is
+ * p->normal), shown as a slab for a plane, a trunk segment for a cylinder and a globe for a
+ * sphere, into a p->preview_width x p->preview_height RGB 8-bit sRGB image (allocated into *out).
+ * Deterministic for a given mesh on a given machine. Returns 0, or -1 with fs_error
+ * (FS_ERR_DATA for a size outside 16..16384, FS_ERR_INTERNAL when OSMesa fails). */
 int fs_render_preview(const fs_render_mesh *m, const fs_domain *d, const fs_render_params *p, const fs_maps *maps,
                       fs_image *out);
 
