@@ -1,10 +1,11 @@
-/* Benchmark of the wedge model's equilibrium: assembly, analysis, factorization, solves (CHOLMOD and CG), factor updates; bench_wedge N [plane|periodic|sphere] [thickness]. */
+/* Benchmark of the wedge model's equilibrium: assembly, analysis, factorization, solves (CHOLMOD and CG), factor updates, local versus global relaxation per event; bench_wedge N [plane|periodic|sphere] [thickness]. */
 #include <errno.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "base/error.h"
 #include "base/log.h"
@@ -21,13 +22,24 @@
 /* Element removals timed for the factor updates. */
 #define BENCH_REMOVALS 50
 
+/* CPU seconds of the process (all threads): the machine running a benchmark may be shared. */
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 static void usage(void)
 {
     fprintf(stderr, "usage: bench_wedge N [plane|periodic|sphere] [thickness]\n"
                     "  builds a wedge layer of about N elements (points %g cm apart, default thickness 0.3 cm)\n"
                     "  under uneven shrinkage and prints one line of timings: assembly, symbolic analysis,\n"
                     "  numeric factorization, one CHOLMOD solve, one CG solve of the same system (tolerance\n"
-                    "  1e-8, cold start), and the mean factor update and solve after element removals.\n",
+                    "  1e-8, cold start), the mean factor update and solve after element removals, and the\n"
+                    "  mean cost of one event's relaxation after the same removals on two fresh models:\n"
+                    "  global (re-factorization of the stale factor, solve, all stresses) and local (thesis\n"
+                    "  5.8), in wall and CPU seconds.\n",
             BENCH_SPACING);
 }
 
@@ -57,6 +69,7 @@ int main(int argc, char **argv)
     cfg.shrink.top.t[1] = cfg.shrink.bottom.t[1] = 1.0;
     cfg.shrink.top.v[1] = 0.01;
     cfg.shrink.bottom.v[1] = 0.005;
+    cfg.solver.relax = FS_RELAX_GLOBAL;
     int32_t points = (int32_t)(n / 2);
     double area = 0.5 * sqrt(3.0) * points * BENCH_SPACING * BENCH_SPACING;
     if (!strcmp(kind, "plane") || !strcmp(kind, "periodic")) {
@@ -122,12 +135,58 @@ int main(int argc, char **argv)
     }
     double refactor = fs_seconds() - t0;
 
+    /* the same removals relaxed after each event: globally (re-factorization of the stale factor, solve,
+     * all stresses) and by local relaxation (thesis §5.8), on two fresh models */
+    fs_config lcfg = cfg;
+    lcfg.solver.relax = FS_RELAX_LOCAL;
+    if (getenv("RELAX_TOL"))
+        lcfg.solver.relax_tolerance = strtod(getenv("RELAX_TOL"), NULL);
+    fs_wedge_model wg, wl;
+    if (fs_wedge_init(&wg, &m, &lcfg) < 0 || fs_wedge_equilibrium(&wg, 1.0) < 0 || fs_wedge_init(&wl, &m, &lcfg) < 0 ||
+        fs_wedge_equilibrium(&wl, 1.0) < 0) {
+        fprintf(stderr, "bench_wedge: %s\n", fs_error_message());
+        return 70;
+    }
+    double global_event = 0.0, local_event = 0.0, global_cpu = 0.0, local_cpu = 0.0, diff_local = 0.0, scale_local = 0.0;
+    for (int32_t e = 0, k = 0; e < w.n_elems && k < BENCH_REMOVALS; e += w.n_elems / BENCH_REMOVALS + 1, k++) {
+        if (fs_wedge_remove(&wg, e) < 0 || fs_wedge_remove(&wl, e) < 0) {
+            fprintf(stderr, "bench_wedge: %s\n", fs_error_message());
+            return 70;
+        }
+        t0 = fs_seconds();
+        double c0 = cpu_seconds();
+        int rc = fs_wedge_equilibrium(&wg, 1.0);
+        double t1 = fs_seconds(), c1 = cpu_seconds();
+        rc |= fs_wedge_relax(&wl, NULL, 0);
+        double t2 = fs_seconds(), c2 = cpu_seconds();
+        global_cpu += c1 - c0;
+        local_cpu += c2 - c1;
+        if (rc < 0) {
+            fprintf(stderr, "bench_wedge: %s\n", fs_error_message());
+            return 70;
+        }
+        global_event += t1 - t0;
+        local_event += t2 - t1;
+    }
+    for (size_t i = 0; i < 6 * (size_t)wl.n_nodes; i++) {
+        diff_local = fmax(diff_local, fabs(wl.u[i] - wg.u[i]));
+        scale_local = fmax(scale_local, fabs(wg.u[i]));
+    }
+    int64_t relaxations = wl.counters.local_relaxations + wl.counters.global_fallbacks;
+
     printf("wedge %-8s elements %8d dofs %8d nnz(K) %9d nnz(L) %10.0f flops %9.3g %s %s  assemble %7.3f s  analyze %7.3f s  "
            "factor %7.3f s  solve %7.4f s  stresses %7.4f s  cg %7.3f s (%d it, diff %.1e)  update %7.4f s  "
-           "solve-after %7.4f s  refactor %7.3f s\n",
+           "solve-after %7.4f s  refactor %7.3f s  global-event %7.4f s (cpu %7.4f s)  local-event %7.4f s (cpu %7.4f s; "
+           "%.1fx wall, %.1fx cpu, %lld/%lld fallbacks, %.0f unknowns, diff %.1e)\n",
            kind, (int)w.n_elems, (int)w.n_free, fs_sparse_matrix_nnz(&w.k_free), info.factor_nonzeros,
            info.flops, info.ordering, info.supernodal ? "supernodal" : "simplicial", assemble, analyze, factor, solve, stress, cg, iterations,
-           scale > 0 ? diff / scale : diff, update, solve_after, refactor);
+           scale > 0 ? diff / scale : diff, update, solve_after, refactor, global_event / removed, global_cpu / removed,
+           local_event / removed, local_cpu / removed, local_event > 0.0 ? global_event / local_event : 0.0,
+           local_cpu > 0.0 ? global_cpu / local_cpu : 0.0, (long long)wl.counters.global_fallbacks,
+           (long long)relaxations, relaxations ? (double)wl.counters.local_dofs / (double)relaxations : 0.0,
+           scale_local > 0 ? diff_local / scale_local : diff_local);
+    fs_wedge_free(&wg);
+    fs_wedge_free(&wl);
     fs_wedge_free(&w);
     fs_mesh_free(&m);
     return 0;

@@ -20,8 +20,8 @@ run_small() { # NAME PRESET W H [extra options]
         not_ok "$name.json exists"
     fi
     n=$(wc -l < "$tmp/stdout")
-    # 8 maps (with the preview and the occlusion), the crack graph's JSON and SVG, the sidecar.
-    [ "$n" -eq 11 ] && ok "stdout lists the 11 files written" || not_ok "stdout lists the 11 files written (got $n lines)"
+    # 7 maps (with the occlusion; the preview is opt-in), the crack graph's JSON and SVG, the sidecar.
+    [ "$n" -eq 10 ] && ok "stdout lists the 10 files written" || not_ok "stdout lists the 10 files written (got $n lines)"
     leftovers=$(find "$d" -name '.*tmp*' | wc -l)
     [ "$leftovers" -eq 0 ] && ok "no temporary file is left" || not_ok "no temporary file is left"
 }

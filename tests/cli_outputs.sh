@@ -19,7 +19,7 @@ check() {
 while read -r name preset elements geometry; do
     d="$tmp/$name"
     expect_status 0 "$preset: maps, preview and mesh" "$FISSURE" -q -o "$d" -n "$name" --size 96x96 \
-        --set mesh.elements="$elements" --set render.preview_size=160x120 --mesh "$d/$name.obj" \
+        --set mesh.elements="$elements" --set render.preview_size=160x120 --mesh "$d/$name.obj" --maps all \
         "$PRESETS/$preset.ini"
     expect_png "$d/${name}_preview.png" 160 120 8 2
     check "$name preview shows a shaded object" "$helpers/preview_check" "$d/${name}_preview.png"
@@ -27,11 +27,34 @@ while read -r name preset elements geometry; do
     grep -qx "$d/$name.obj" "$tmp/stdout" && ok "stdout lists the mesh" || not_ok "stdout lists the mesh"
     sed -n '/"preview": {/,/}/p' "$d/$name.json" | grep -q '"color_space": "srgb"' \
         && ok "the sidecar calls the preview sRGB" || not_ok "the sidecar calls the preview sRGB"
+    # a perspective view never tiles, even where the texture maps do
+    sed -n '/"preview": {/,/}/p' "$d/$name.json" | tr -d ' \n' | grep -q '"tileable":{"u":false,"v":false' \
+        && ok "the sidecar calls the preview not tileable" || not_ok "the sidecar calls the preview not tileable"
 done <<EOF
 tile voronoi-tile 150 plane 20 20 0.4
 plane voronoi-plane 150 plane 20 20 0.4
 trunk voronoi-trunk 150 cylinder 5 40 0.5
 sphere voronoi-sphere 300 sphere 10 0.3
+EOF
+
+# The physical models' meshes over several seeds: each fragment's surface is a manifold (fragments
+# that touch at a corner or along a line get their own copies of the positions there), bounded only
+# on the domain's borders, and the whole is one piece (equal positions taken as one) with the
+# domain's Euler characteristic.
+while read -r preset elements seeds geometry; do
+    for seed in $(echo "$seeds" | tr , ' '); do
+        d="$tmp/obj-$preset-$seed"
+        "$FISSURE" -q -o "$d" -n o -s "$seed" --size 32x32 --set mesh.elements="$elements" --maps height \
+            --mesh "$d/o.obj" "$PRESETS/$preset.ini" >/dev/null 2>&1 || { not_ok "$preset seed $seed runs"; continue; }
+        check "$preset seed $seed: the OBJ is a manifold per fragment, correctly bounded" \
+            "$helpers/obj_check" "$d/o.obj" $geometry
+    done
+done <<EOF
+mud-remove 600 1,2,3 plane 8 8 1
+bark-remove 500 2,3 cylinder 2 12 5
+mud-springs 600 1,2 plane 10 10 0.5
+hex-springs 400 2 plane 10 10 0.5
+voronoi-trunk 100 2,3 cylinder 5 40 0.5
 EOF
 
 # The helpers can fail: a flat map filling the frame is no preview.
@@ -49,10 +72,17 @@ n=$(wc -l < "$tmp/stdout")
 
 # Same seed, same files.
 "$FISSURE" -q -o "$tmp/again" -n tile $small --set render.preview_size=160x120 --mesh "$tmp/again/tile.obj" \
-    "$PRESETS/voronoi-tile.ini" >/dev/null 2>&1
+    --maps all "$PRESETS/voronoi-tile.ini" >/dev/null 2>&1
 cmp -s "$tmp/tile/tile_preview.png" "$tmp/again/tile_preview.png" && ok "the preview is deterministic" \
     || not_ok "the preview is deterministic"
 cmp -s "$tmp/tile/tile.obj" "$tmp/again/tile.obj" && ok "the mesh is deterministic" || not_ok "the mesh is deterministic"
+
+sed -n '/"basecolor": {/,/}/p' "$tmp/tile/tile.json" | tr -d ' \n' | grep -q '"tileable":{"u":true,"v":true' \
+    && ok "the tile's basecolor is tileable" || not_ok "the tile's basecolor is tileable"
+# The preview is opt-in: the default maps leave it out.
+expect_status 0 "default maps" "$FISSURE" -q -o "$tmp/default" -n d $small "$PRESETS/voronoi-tile.ini"
+[ ! -e "$tmp/default/d_preview.png" ] && [ -f "$tmp/default/d_basecolor.png" ] \
+    && ok "the default maps leave the preview out" || not_ok "the default maps leave the preview out"
 
 # --mesh in another directory than -o: created and written there, atomically.
 expect_status 0 "--mesh elsewhere" "$FISSURE" -q -o "$tmp/maps" -n m --set mesh.elements=40 --size 32x32 \

@@ -9,12 +9,15 @@
  * Reads the file on its own (independently of the writer) and checks, printing one line per
  * failure and a summary "V E F euler components boundary":
  *  - every face is a triangle "f p/t/n p/t/n p/t/n" with indices in range;
- *  - texture coordinates lie in [0, 1], normals are unit, no two positions coincide;
- *  - every edge is shared by at most two triangles, running opposite ways (consistent orientation);
+ *  - texture coordinates lie in [0, 1], normals are unit, no two positions are closer than the weld
+ *    tolerance unless they are equal: equal ones are copies where fragments touch (at most 2 % of
+ *    the positions);
+ *  - every edge is shared by at most two triangles, running opposite ways (consistent orientation),
+ *    so each fragment's surface is a manifold;
  *  - boundary edges lie only on the domain's borders: the four sides of a plane (a tile is a flat
  *    slab in 3-D), the two ends of a cylinder; a sphere has none;
- *  - the surface is one piece with the Euler characteristic of a disk (plane, 1), an open tube
- *    (cylinder, 0) or a sphere (2);
+ *  - with equal positions taken as one, the surface is one piece with the Euler characteristic of a
+ *    disk (plane, 1), an open tube (cylinder, 0) or a sphere (2);
  *  - each corner sits where its texture coordinate says (plane (u W, v H), cylinder angle 2 pi u and
  *    z = v H, sphere longitude 2 pi u and latitude pi v - pi/2), at a height in [0, DEPTH] above the
  *    domain surface along its normal;
@@ -255,14 +258,26 @@ int main(int argc, char **argv)
                 order[j - gap] = t;
             }
     double weld = 1e-7 * size;
+    int32_t *canon = malloc(sizeof *canon * (size_t)(np + 1)); /* equal positions as one */
+    for (int32_t i = 0; i < np; i++)
+        canon[i] = i;
+    int32_t copies = 0;
     for (int32_t i = 0; i < np; i++)
         for (int32_t j = i + 1; j < np && pos[3 * order[j]] - pos[3 * order[i]] <= weld; j++) {
             const double *a = pos + 3 * order[i], *b = pos + 3 * order[j];
             double dd = sqrt(dist2(a, b));
-            if (dd <= weld)
+            if (dd == 0.0) {
+                int32_t ra = find(canon, order[i]), rb = find(canon, order[j]);
+                copies += ra != rb;
+                if (ra != rb)
+                    canon[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+            } else if (dd <= weld) {
                 fail("positions %g apart are not welded (at x = %g)", dd, a[0]);
+            }
         }
     free(order);
+    if (copies > np / 50)
+        fail("%g of %g positions are copies of others", copies, np);
 
     /* Corners, normals and facing. */
     for (int32_t i = 0; i < nf; i++) {
@@ -304,7 +319,9 @@ int main(int argc, char **argv)
                 c[q] = (p[0][q] + p[1][q] + p[2][q]) / 3.0;
             height_of(&d, c, up);
             double facing = (fn[0] * up[0] + fn[1] * up[1] + fn[2] * up[2]) / area2;
-            if (facing <= 0.0)
+            /* walls a model drew itself (the springs cells' sides) stand upright: within a degree of
+             * vertical, rounding decides the sign */
+            if (facing <= -0.02)
                 fail("layer face %g faces inwards (cosine %g)", i + 1, facing);
         }
     }
@@ -344,17 +361,41 @@ int main(int argc, char **argv)
         }
         i = j;
     }
+    /* pieces and the Euler characteristic with equal positions taken as one */
+    for (int32_t i = 0; i < nf; i++)
+        for (int k = 0; k < 3; k++) {
+            int32_t a = find(canon, fc[i].p[k]), b = find(canon, fc[i].p[(k + 1) % 3]);
+            e[3 * i + k] = (edge){a < b ? a : b, a < b ? b : a, i, (int8_t)(a < b)};
+        }
+    qsort(e, 3 * (size_t)nf, sizeof *e, cmp_edge);
+    for (int32_t i = 0; i < nf; i++)
+        parent[i] = i;
+    n_edges = 0;
+    for (size_t i = 0; i < 3 * (size_t)nf;) {
+        size_t j = i + 1;
+        while (j < 3 * (size_t)nf && e[j].a == e[i].a && e[j].b == e[i].b)
+            j++;
+        n_edges++;
+        for (size_t q = i + 1; q < j; q++) {
+            int32_t ra = find(parent, e[i].f), rb = find(parent, e[q].f);
+            if (ra != rb)
+                parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+        }
+        i = j;
+    }
     int32_t components = 0;
     for (int32_t i = 0; i < nf; i++)
         components += find(parent, i) == i;
     char *used = calloc((size_t)np + 1, 1);
     int32_t n_used = 0;
     for (int32_t i = 0; i < nf; i++)
-        for (int k = 0; k < 3; k++)
-            if (!used[fc[i].p[k]]) {
-                used[fc[i].p[k]] = 1;
+        for (int k = 0; k < 3; k++) {
+            int32_t v = find(canon, fc[i].p[k]);
+            if (!used[v]) {
+                used[v] = 1;
                 n_used++;
             }
+        }
     for (int32_t i = 0; i < np; i++)
         if (used[i] && d.type == 2 && on_border(&d, pos + 3 * i))
             fail("a sphere position lies on a border (position %g)%.0g", i + 1, 0);
@@ -366,9 +407,10 @@ int main(int argc, char **argv)
         fail("Euler characteristic V - E + F = %g, expected %g", (double)euler, (double)want);
     if (d.type == 2 && n_boundary)
         fail("a sphere has %g boundary edges, expected %g", n_boundary, 0);
-    printf("V=%d E=%d F=%d euler=%ld components=%d boundary=%d\n", (int)n_used, (int)n_edges, (int)nf, euler,
-           (int)components, (int)n_boundary);
+    printf("V=%d E=%d F=%d euler=%ld components=%d boundary=%d copies=%d\n", (int)n_used, (int)n_edges, (int)nf,
+           euler, (int)components, (int)n_boundary, (int)copies);
     free(used);
+    free(canon);
     free(parent);
     free(e);
     free(pos);

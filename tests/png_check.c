@@ -157,6 +157,24 @@ static int ids(const char *path)
     return 0;
 }
 
+/* Prints the mean of a single-channel 8-bit image as a fraction of 255 (a crack mask's coverage). */
+static int coverage(const char *path)
+{
+    fs_image img = {0};
+    if (fs_image_read(path, &img) < 0 || img.type != FS_PIX_U8 || img.channels != 1) {
+        fprintf(stderr, "png_check: %s: expected an 8-bit grey image\n", path);
+        return 2;
+    }
+    const uint8_t *p = img.data;
+    size_t n = (size_t)img.width * (size_t)img.height;
+    uint64_t sum = 0;
+    for (size_t k = 0; k < n; k++)
+        sum += p[k];
+    printf("%.6f\n", (double)sum / (255.0 * (double)n));
+    fs_image_free(&img);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 3 && !strcmp(argv[1], "info"))
@@ -167,6 +185,9 @@ int main(int argc, char **argv)
         return channel(argv[2], atoi(argv[3]), argv[4], atoi(argv[5]));
     if (argc == 3 && !strcmp(argv[1], "ids"))
         return ids(argv[2]);
-    fprintf(stderr, "usage: png_check info PNG | greenflip OPENGL DIRECTX | channel A CA B|=V CB | ids PNG\n");
+    if (argc == 3 && !strcmp(argv[1], "coverage"))
+        return coverage(argv[2]);
+    fprintf(stderr, "usage: png_check info PNG | greenflip OPENGL DIRECTX | channel A CA B|=V CB | ids PNG | "
+            "coverage PNG\n");
     return 2;
 }

@@ -220,6 +220,58 @@ static void uneven_steps(void)
     fs_render_mesh_free(&m);
 }
 
+/* Two raised cells touching only at the centre of the plane, across two crack floors (a checkerboard
+ * of quads, as wedge elements alive on one diagonal of a node and removed on the other): the four
+ * walls at the centre would share one upright edge. The lift gives each cell its own copies of the
+ * centre's top position and of that edge, so every edge has at most two triangles running opposite
+ * ways, and the two cells share no position above the floor. */
+static void touching_corners(void)
+{
+    fs_render_mesh m = {0};
+    add_quad(&m, 0.0, 0.0, 0.5, 0.5, 0.2);
+    add_quad(&m, 0.5, 0.5, 1.0, 1.0, 0.2);
+    add_quad(&m, 0.5, 0.0, 1.0, 0.5, 0.0);
+    add_quad(&m, 0.0, 0.5, 0.5, 1.0, 0.0);
+    fs_domain d = fs_domain_default();
+    fs_lifted_mesh l;
+    CHECK(fs_render_mesh_lift(&m, &d, 1.0, &l) == 0);
+    int32_t *edges, bad = -1;
+    fs_lifted_mesh_boundary(&l, &edges, &bad);
+    free(edges);
+    CHECK_MSG(bad == 0, "%d edges with more than two triangles or running the same way", (int)bad);
+    /* the centre's top (5, 5, 0.2): one copy per cell */
+    int32_t copies = 0;
+    for (int32_t i = 0; i < l.n_pos; i++)
+        copies += fabs(l.pos[3 * i] - 5.0) < 1e-9 && fabs(l.pos[3 * i + 1] - 5.0) < 1e-9 &&
+                  fabs(l.pos[3 * i + 2] - 0.2) < 1e-6;
+    CHECK_MSG(copies == 2, "%d positions at the centre's top, expected 2", (int)copies);
+    /* no triangle of one cell's top (u < 1/2, v < 1/2) uses a position of the other's */
+    int32_t shared = 0;
+    for (int32_t f = 0; f < l.n_tris; f++) {
+        if (l.wall[f])
+            continue;
+        for (int32_t g = 0; g < l.n_tris; g++) {
+            if (l.wall[g])
+                continue;
+            double cf = 0.0, cg = 0.0, hf = 0.0, hg = 0.0;
+            for (int k = 0; k < 3; k++) {
+                cf += l.pos[3 * l.corner[9 * f + 3 * k]] + l.pos[3 * l.corner[9 * f + 3 * k] + 1];
+                cg += l.pos[3 * l.corner[9 * g + 3 * k]] + l.pos[3 * l.corner[9 * g + 3 * k] + 1];
+                hf += l.pos[3 * l.corner[9 * f + 3 * k] + 2];
+                hg += l.pos[3 * l.corner[9 * g + 3 * k] + 2];
+            }
+            if (hf < 0.5 || hg < 0.5 || !(cf < 30.0 && cg > 30.0))
+                continue;
+            for (int a = 0; a < 3; a++)
+                for (int b = 0; b < 3; b++)
+                    shared += l.corner[9 * f + 3 * a] == l.corner[9 * g + 3 * b];
+        }
+    }
+    CHECK_MSG(shared == 0, "the two cells' tops share %d corners", (int)shared);
+    fs_lifted_mesh_free(&l);
+    fs_render_mesh_free(&m);
+}
+
 /* The OBJ file holds exactly the lifted mesh: as many v, vt, vn and f lines as positions, texture
  * vertices, normals and triangles, walls in their own group, and the same bytes for the same mesh. */
 static void obj_file(void)
@@ -269,6 +321,7 @@ int main(void)
     RUN(sphere_closed);
     RUN(coincident_cancel);
     RUN(uneven_steps);
+    RUN(touching_corners);
     RUN(obj_file);
     return check_finish();
 }

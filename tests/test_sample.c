@@ -168,6 +168,42 @@ static void test_deterministic(void)
     }
 }
 
+/* FNV-1a hash of the bytes of the coordinates. */
+static uint64_t points_hash(const fs_points *pts)
+{
+    uint64_t h = UINT64_C(14695981039346656037);
+    const unsigned char *c = (const unsigned char *)pts->p;
+    for (size_t i = 0; i < 3 * (size_t)pts->n * sizeof(double); i++) {
+        h ^= c[i];
+        h *= UINT64_C(1099511628211);
+    }
+    return h;
+}
+
+/* Sets large enough to be sampled on several threads give, bit for bit, the points that the
+ * sampler gave when it ran on one thread (the hashes were taken then). */
+static void test_threads_keep_the_points(void)
+{
+    struct {
+        const char *name;
+        fs_domain d;
+        uint64_t hash;
+    } c[3] = {
+        {"plane", make_domain(FS_DOMAIN_PLANE, 16, 14, 0, false, false), UINT64_C(0x0e61810501590d0d)},
+        {"periodic plane", make_domain(FS_DOMAIN_PLANE, 12, 17, 0, true, true), UINT64_C(0xfc321a144a0af033)},
+        {"sphere", make_domain(FS_DOMAIN_SPHERE, 0, 0, 4, false, false), UINT64_C(0x6328ad6da89d63bc)},
+    };
+    for (int k = 0; k < 3; k++) {
+        fs_sample_params sp = params(25000, 7);
+        fs_points pts = {0};
+        CHECK(fs_sample_repulsion(&c[k].d, &sp, &pts) == 0);
+        uint64_t h = points_hash(&pts);
+        CHECK_MSG(h == c[k].hash, "%s: points hash %016llx, expected %016llx", c[k].name, (unsigned long long)h,
+                  (unsigned long long)c[k].hash);
+        fs_points_free(&pts);
+    }
+}
+
 /* Tiny point sets make grids of one or two cells, where a cell neighbours its own periodic images. */
 static void test_tiny_sets(void)
 {
@@ -393,6 +429,7 @@ int main(void)
     RUN(test_repulsion_spreads_evenly);
     RUN(test_random_points_fail_the_bounds);
     RUN(test_deterministic);
+    RUN(test_threads_keep_the_points);
     RUN(test_tiny_sets);
     RUN(test_hex_plane);
     RUN(test_hex_periodic);

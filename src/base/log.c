@@ -4,6 +4,8 @@
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <string.h>
+#include <sys/ioctl.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -52,21 +54,99 @@ void fs_warn(const char *fmt, ...)
     va_end(ap);
 }
 
+/* The progress line's state: what is shown, when it was drawn, and where the ETA measures from. */
+static struct {
+    int tty;                 /* stderr is a terminal: -1 not checked yet, else 0 or 1 */
+    double origin;           /* time of the first progress call (elapsed counts from it) */
+    double last_draw;        /* time of the last redraw */
+    char drawn_phase[32];    /* phase of the last redraw */
+    char rate_phase[32];     /* fractional phase the ETA measures */
+    double rate_t0, rate_f0; /* when that phase began and its fraction then */
+    double scale;            /* fs_progress_scale, 0 meaning 1 */
+} prog = {.tty = -1};
+
+void fs_progress_scale(double scale) { prog.scale = scale; }
+
+/* "M:SS", or "H:MM:SS" from an hour. */
+static void clock_text(char *buf, size_t size, double seconds)
+{
+    long s = seconds > 0.0 ? (long)(seconds + 0.5) : 0;
+    if (s >= 3600)
+        snprintf(buf, size, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
+    else
+        snprintf(buf, size, "%ld:%02ld", s / 60, s % 60);
+}
+
+double fs_progress_eta(double seconds, double f0, double f)
+{
+    if (!(seconds >= 0.0) || !(f0 >= 0.0) || !(f <= 1.0) || !(f - f0 >= 0.005))
+        return -1.0;
+    return seconds * (1.0 - f) / (f - f0);
+}
+
+char *fs_progress_format(char *buf, size_t size, const char *phase, double fraction, const char *detail,
+                         double elapsed, double eta)
+{
+    char pct[8] = "", el[24], left[32] = "";
+    if (fraction >= 0.0)
+        snprintf(pct, sizeof pct, "%3.0f%%  ", 100.0 * (fraction > 1.0 ? 1.0 : fraction));
+    clock_text(el, sizeof el, elapsed);
+    if (eta >= 0.0) {
+        char e[24];
+        clock_text(e, sizeof e, eta);
+        snprintf(left, sizeof left, ", ETA %s", e);
+    } else if (fraction >= 0.0) {
+        snprintf(left, sizeof left, ", ETA --:--");
+    }
+    snprintf(buf, size, "%-8s %s%s  %s elapsed%s", phase, pct, detail, el, left);
+    return buf;
+}
+
+static int terminal_columns(void)
+{
+    struct winsize ws;
+    if (ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col >= 20)
+        return ws.ws_col;
+    return 80;
+}
+
 void fs_progress(const char *phase, double fraction, const char *fmt, ...)
 {
-    if (log_level < FS_LOG_NORMAL || !isatty(STDERR_FILENO))
+    if (log_level < FS_LOG_NORMAL)
         return;
-    char detail[160];
+    if (prog.tty < 0)
+        prog.tty = isatty(STDERR_FILENO) ? 1 : 0;
+    if (!prog.tty)
+        return;
+    double now = fs_seconds();
+    if (prog.origin == 0.0)
+        prog.origin = now;
+    if (fraction >= 0.0) {
+        fraction *= prog.scale > 0.0 ? prog.scale : 1.0;
+        if (strncmp(prog.rate_phase, phase, sizeof prog.rate_phase - 1) || fraction < prog.rate_f0) {
+            snprintf(prog.rate_phase, sizeof prog.rate_phase, "%s", phase);
+            prog.rate_t0 = now;
+            prog.rate_f0 = fraction;
+        }
+    }
+    bool same_phase = !strncmp(prog.drawn_phase, phase, sizeof prog.drawn_phase - 1);
+    if (progress_open && same_phase && now - prog.last_draw < 0.1)
+        return;
+    char detail[160], line[320];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(detail, sizeof detail, fmt, ap);
     va_end(ap);
-    if (fraction >= 0)
-        fprintf(stderr, "\r\033[K%-10s %3.0f%%  %s", phase, 100.0 * (fraction > 1 ? 1 : fraction), detail);
-    else
-        fprintf(stderr, "\r\033[K%-10s %s", phase, detail);
+    double eta = fraction >= 0.0 ? fs_progress_eta(now - prog.rate_t0, prog.rate_f0, fraction) : -1.0;
+    fs_progress_format(line, sizeof line, phase, fraction, detail, now - prog.origin, eta);
+    int columns = terminal_columns();
+    if ((int)strlen(line) > columns - 1)
+        line[columns - 1] = '\0';
+    fprintf(stderr, "\r\033[K%s", line);
     fflush(stderr);
     progress_open = true;
+    prog.last_draw = now;
+    snprintf(prog.drawn_phase, sizeof prog.drawn_phase, "%s", phase);
 }
 
 void fs_progress_done(void)

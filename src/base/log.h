@@ -2,6 +2,8 @@
 #ifndef FS_BASE_LOG_H
 #define FS_BASE_LOG_H
 
+#include <stddef.h>
+
 typedef enum { FS_LOG_QUIET = 0, FS_LOG_NORMAL = 1, FS_LOG_VERBOSE = 2 } fs_log_level;
 
 void fs_log_set_level(fs_log_level level);
@@ -14,10 +16,30 @@ void fs_debug(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 /* Warning, shown unless quiet. */
 void fs_warn(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 
-/* Progress line for a phase (rewritten in place) when stderr is a terminal and not quiet;
- * fraction in [0,1], or negative when unknown. fs_progress_done() ends the line. */
+/* Progress line for a phase (rewritten in place with \r) when stderr is a terminal and not quiet;
+ * fraction in [0,1] (simulated time / end), or negative when unknown. The line shows the phase,
+ * the percentage, the detail, the time elapsed since the first progress line and the ETA; it is
+ * redrawn at most 10 times a second (at once when the phase changes) and cut to the terminal's
+ * width. fs_progress_done() clears it; log lines clear it first and it comes back on the next call.
+ * design: the ETA extrapolates the rate of the fraction since the phase began (a fractional phase
+ * begins when its name changes or its fraction goes back), so it follows simulated time, not the
+ * number of events, which bunch up as cracks cascade. */
 void fs_progress(const char *phase, double fraction, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 void fs_progress_done(void);
+
+/* Multiplies the fractions given to fs_progress from now on by scale (1 at start): a model that runs
+ * a segment [.., t_k] of a run to `end` reports time / t_k, shown as time / end with scale t_k / end. */
+void fs_progress_scale(double scale);
+
+/* The progress line's text, without escape codes, into buf (size bytes, always terminated):
+ * "PHASE  NN%  DETAIL  M:SS elapsed, ETA M:SS"; the percentage only for fraction >= 0, the ETA
+ * only for eta >= 0 ("ETA --:--" when a fraction is known but eta is not). Returns buf. */
+char *fs_progress_format(char *buf, size_t size, const char *phase, double fraction, const char *detail,
+                         double elapsed, double eta);
+
+/* Seconds left at a constant rate: the fraction went from f0 to f in `seconds`; negative (unknown)
+ * when it has not advanced by at least 0.5 % or the inputs are out of range. */
+double fs_progress_eta(double seconds, double f0, double f);
 
 /* Wall-clock seconds since an arbitrary origin (monotonic). */
 double fs_seconds(void);

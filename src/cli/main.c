@@ -45,11 +45,16 @@ typedef struct {
     bool list_presets, dump_preset;
     fs_target target;      /* --target: the engine the maps are named, packed and oriented for */
     const char *mesh_path; /* --mesh FILE: the lifted 3-D layer as Wavefront OBJ, or NULL */
+    bool have_maps;        /* --maps was given (it also picks the frames' maps) */
+    int32_t frames;        /* --frames N: time-lapse frames, 0 for none */
 } options;
 
 enum {
-    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET
+    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET, OPT_FRAMES
 };
+
+/* Most time-lapse frames one run writes. */
+#define MAX_FRAMES 10000
 
 static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},
@@ -66,6 +71,7 @@ static const struct option long_options[] = {
     {"list-presets", no_argument, NULL, OPT_LIST},
     {"dump-preset", no_argument, NULL, OPT_DUMP},
     {"mesh", required_argument, NULL, OPT_MESH},
+    {"frames", required_argument, NULL, OPT_FRAMES},
     {"help", no_argument, NULL, 'h'},
     {"version", no_argument, NULL, 'V'},
     {NULL, 0, NULL, 0},
@@ -86,13 +92,16 @@ static void print_help(FILE *out)
           "                          override one preset key (repeatable)\n"
           "      --maps LIST         comma-separated maps to write: height, normal, basecolor,\n"
           "                          crackmask, crackdist, cellid, preview, occlusion, cracks\n"
-          "                          (crack graph JSON and SVG), or all (default: all)\n"
+          "                          (crack graph JSON and SVG), or all (default: all but preview)\n"
           "      --format png|exr    height map as 16-bit PNG (default) or float EXR in cm\n"
           "      --normal opengl|directx\n"
           "                          normal map convention (default: opengl, +Y up)\n"
           "      --target ENGINE     name, pack and orient the maps for generic (default), gltf,\n"
           "                          unreal, unity-hdrp or blender\n"
           "      --mesh FILE         also write the cracked 3-D layer to FILE as Wavefront OBJ\n"
+          "      --frames N          also write N time-lapse frames NAME_frame_0001_MAP.png ... of the\n"
+          "                          crack growth (maps: those of --maps that are texture maps, else\n"
+          "                          basecolor and crackmask; springs and wedge models only)\n"
           "  -q, --quiet             print nothing on stderr but errors\n"
           "  -v, --verbose           print details of each phase on stderr\n"
           "      --list-presets      list the presets on the preset path, one a line, and exit\n"
@@ -185,6 +194,7 @@ static int parse_options(int argc, char **argv, options *o)
             o->sets[o->n_sets++] = optarg;
             break;
         case OPT_MAPS:
+            o->have_maps = true;
             if (!parse_maps(optarg, o->maps))
                 return usage_error("--maps: expected a comma-separated list of height, normal, basecolor, "
                                    "crackmask, crackdist, cellid, preview, occlusion, cracks or all, got '%s'",
@@ -206,6 +216,16 @@ static int parse_options(int argc, char **argv, options *o)
                 return usage_error("--target: expected generic, gltf, unreal, unity-hdrp or blender, got '%s'",
                                    optarg);
             break;
+        case OPT_FRAMES: {
+            char *end;
+            errno = 0;
+            long v = strtol(optarg, &end, 10);
+            if (end == optarg || *end || errno || v < 1 || v > MAX_FRAMES)
+                return usage_error("--frames: expected a number of frames from 1 to 10000, got '%s'",
+                                   optarg);
+            o->frames = (int32_t)v;
+            break;
+        }
         case 'q': fs_log_set_level(FS_LOG_QUIET); break;
         case 'v': fs_log_set_level(FS_LOG_VERBOSE); break;
         case OPT_LIST: o->list_presets = true; break;
@@ -312,11 +332,118 @@ static fs_output *stage_mesh(const char *path, const fs_config *cfg, const fs_re
     return out;
 }
 
+/* Map kinds a time-lapse frame can have: the texture-space rasters. */
+static bool frame_kind(int kind)
+{
+    return kind == MAP_HEIGHT || kind == MAP_NORMAL || kind == MAP_BASECOLOR || kind == MAP_CRACKMASK ||
+           kind == MAP_CRACKDIST || kind == MAP_CELLID;
+}
+
+/* The time-lapse frames of one run: each frame is rendered and staged as it comes, in an output set
+ * of its own that is committed together with the final maps. */
+typedef struct {
+    const options *o;
+    const fs_config *cfg;
+    const char *name;
+    fs_output *out;                    /* the staged frame files; NULL until the first frame */
+    const char *kinds[MAP_COUNT];      /* the maps of every frame */
+    int n_kinds;
+    double *time, *height_min, *height_max; /* per frame */
+    int64_t *fractures;
+    char (*file)[512];                 /* every frame file, frame by frame */
+    int n_files;
+    fs_sidecar_map map[MAP_COUNT];     /* per kind, from the first frame: what the sidecar says */
+    fs_image header[MAP_COUNT];        /* their sizes and types (no pixels) */
+    char pattern[MAP_COUNT][600];      /* their file name patterns */
+} frame_writer;
+
+static void frame_writer_init(frame_writer *fw, const options *o, const fs_config *cfg, const char *name)
+{
+    memset(fw, 0, sizeof *fw);
+    fw->o = o;
+    fw->cfg = cfg;
+    fw->name = name;
+    for (int i = 0; i < MAP_COUNT; i++)
+        if (frame_kind(i) && o->have_maps && o->maps[i])
+            fw->kinds[fw->n_kinds++] = map_names[i];
+    if (fw->n_kinds == 0) {
+        fw->kinds[fw->n_kinds++] = map_names[MAP_BASECOLOR];
+        fw->kinds[fw->n_kinds++] = map_names[MAP_CRACKMASK];
+    }
+}
+
+static void frame_writer_free(frame_writer *fw)
+{
+    if (fw->out)
+        fs_output_abort(fw->out);
+    free(fw->time);
+    free(fw->height_min);
+    free(fw->height_max);
+    free(fw->fractures);
+    free(fw->file);
+    memset(fw, 0, sizeof *fw);
+}
+
+/* fs_frame_fn: renders frame k's maps and stages them as NAME_frame_KKKK_KIND.png. */
+static int write_frame(void *ctx, int32_t k, int32_t count, double t, const fs_render_mesh *surface,
+                       const fs_stats *stats)
+{
+    frame_writer *fw = ctx;
+    const fs_config *cfg = fw->cfg;
+    if (!fw->out) {
+        if (!(fw->out = fs_output_begin(fw->o->output_dir)))
+            return -1;
+        fw->time = fs_calloc((size_t)count, sizeof *fw->time);
+        fw->height_min = fs_calloc((size_t)count, sizeof *fw->height_min);
+        fw->height_max = fs_calloc((size_t)count, sizeof *fw->height_max);
+        fw->fractures = fs_calloc((size_t)count, sizeof *fw->fractures);
+        fw->file = fs_calloc((size_t)count * (size_t)fw->n_kinds, sizeof *fw->file);
+    }
+    fs_progress("frames", -1, "frame %d of %d at t = %.4g, %lld fractures", (int)k, (int)count, t,
+                (long long)stats->fractures);
+    fs_domain d = cfg->domain;
+    fs_domain_normalize(&d);
+    bool wu = fs_domain_wraps_u(&d), wv = fs_domain_wraps_v(&d);
+    fs_raster raster = {0};
+    fs_maps maps = {0};
+    int rc = fs_render_raster(surface, cfg->render.width, cfg->render.height, cfg->render.supersample, wu, wv,
+                              &raster);
+    if (rc == 0)
+        rc = fs_maps_build(&raster, &cfg->render, wu, wv, fs_domain_extent_x(&d) / cfg->render.width,
+                           fs_domain_extent_y(&d) / cfg->render.height, &maps);
+    char stem[560];
+    snprintf(stem, sizeof stem, "%s_frame_%04d", fw->name, (int)k);
+    fs_target_inputs in = {.maps = &maps, .height = &maps.height, .height_ext = "png", .normal = cfg->render.normal};
+    fs_target_output *w = fs_calloc(1, sizeof *w);
+    if (rc == 0)
+        rc = fs_target_write(fw->out, FS_TARGET_GENERIC, stem, fw->kinds, fw->n_kinds, &in, w);
+    for (int i = 0; rc == 0 && i < w->n; i++) {
+        snprintf(fw->file[fw->n_files++], sizeof fw->file[0], "%s", w->file[i]);
+        if (k > 1)
+            continue;
+        fw->map[i] = w->map[i];
+        fw->header[i] = (fs_image){w->map[i].image->width, w->map[i].image->height, w->map[i].image->channels,
+                                   w->map[i].image->type, NULL};
+        fw->map[i].image = &fw->header[i];
+        snprintf(fw->pattern[i], sizeof fw->pattern[i], "%s_frame_NNNN_%s.png", fw->name, w->map[i].kind);
+        fw->map[i].file = fw->pattern[i];
+    }
+    fw->time[k - 1] = t;
+    fw->fractures[k - 1] = stats->fractures;
+    fw->height_min[k - 1] = maps.height_min_cm;
+    fw->height_max[k - 1] = maps.height_max_cm;
+    fs_target_output_free(w);
+    free(w);
+    fs_maps_free(&maps);
+    fs_raster_free(&raster);
+    return rc;
+}
+
 /* Writes the selected maps, the sidecar and the --mesh file as one atomic output set; prints the
  * final paths. */
 static int write_outputs(const options *o, const fs_config *cfg, const char *name, const char *preset_text,
                          const fs_result *res, const fs_raster *raster, const fs_maps *maps, const fs_image *preview,
-                         double t_start)
+                         frame_writer *fw, double t_start)
 {
     fs_output *out = fs_output_begin(o->output_dir);
     if (!out)
@@ -366,9 +493,14 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
         rc = -1;
     char json_name[600];
     snprintf(json_name, sizeof json_name, "%s.json", name);
+    char frame_pattern[600];
+    snprintf(frame_pattern, sizeof frame_pattern, "%s_frame_NNNN_KIND.png", name);
+    fs_sidecar_frames frames = {o->frames, frame_pattern, fw->time, fw->fractures, fw->height_min, fw->height_max,
+                                fw->map, fw->n_kinds};
     if (rc == 0)
         rc = fs_sidecar_write(fs_output_stage(out, json_name), cfg, preset_text, &res->stats, maps,
-                              fs_target_name(o->target), written->map, written->n, fs_seconds() - t_start);
+                              fs_target_name(o->target), written->map, written->n, o->frames ? &frames : NULL,
+                              fs_seconds() - t_start);
     fs_target_output_free(written);
     const int n = written->n;
     if (rc < 0) {
@@ -390,6 +522,14 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
         free(written);
         return -1;
     }
+    fs_output *frames_out = fw->out;
+    fw->out = NULL;
+    if (frames_out && fs_output_commit(frames_out) < 0) {
+        free(written);
+        return -1;
+    }
+    for (int i = 0; i < fw->n_files; i++)
+        printf("%s/%s\n", o->output_dir, fw->file[i]);
     for (int i = 0; i < n; i++)
         printf("%s/%s\n", o->output_dir, written->file[i]);
     free(written);
@@ -413,6 +553,11 @@ static int run(const char *preset_arg, const options *o)
         free(preset_path);
         return 0;
     }
+    if (o->frames > 0 && cfg.preset.model == FS_MODEL_VORONOI) {
+        free(preset_path);
+        return usage_error("--frames: %s", "the voronoi model has no time to show frames of; expected a springs or "
+                                           "wedge preset");
+    }
     char *preset_text = read_text(preset_path);
     const char *name = o->name ? o->name : cfg.preset.name;
     fs_info("%s: %s model on a %s, %d elements, seed %" PRIu64 ", %dx%d maps", preset_path,
@@ -424,7 +569,10 @@ static int run(const char *preset_arg, const options *o)
     fs_raster raster = {0};
     fs_maps maps = {0};
     fs_image preview = {0};
-    int rc = fs_sim_run(&cfg, &res);
+    frame_writer fw;
+    frame_writer_init(&fw, o, &cfg, name);
+    fs_sim_frames frames = {o->frames, write_frame, &fw};
+    int rc = fs_sim_run_frames(&cfg, o->frames > 0 ? &frames : NULL, &res);
     if (rc == 0) {
         fs_domain d = cfg.domain;
         fs_domain_normalize(&d);
@@ -442,12 +590,13 @@ static int run(const char *preset_arg, const options *o)
         fs_progress_done();
         fs_debug("rendered in %.2f s", fs_seconds() - t_render);
         if (rc == 0)
-            rc = write_outputs(o, &cfg, name, preset_text, &res, &raster, &maps, &preview, t_start);
+            rc = write_outputs(o, &cfg, name, preset_text, &res, &raster, &maps, &preview, &fw, t_start);
         fs_result_free(&res);
     }
     fs_maps_free(&maps);
     fs_image_free(&preview);
     fs_raster_free(&raster);
+    frame_writer_free(&fw);
     free(preset_text);
     if (rc < 0)
         return fail();
@@ -462,7 +611,7 @@ int main(int argc, char **argv)
 
     options o = {.output_dir = "."};
     for (int i = 0; i < MAP_COUNT; i++)
-        o.maps[i] = true;
+        o.maps[i] = i != MAP_PREVIEW;
     int rc = parse_options(argc, argv, &o);
     if (rc != 0) {
         free(o.sets);

@@ -4,6 +4,7 @@
 #include <libqhull_r/libqhull_r.h>
 #include <math.h>
 #include <pthread.h>
+#include <setjmp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,14 +35,41 @@ static void qhull_first_line(const char *msg, char *out, size_t size)
     out[len] = '\0';
 }
 
-/* design: Qhull reports errors by longjmp to a setjmp inside qh_new_qhull, so no jump crosses our
- * frames; we only read its facet list after a successful return and then free everything. Its
- * messages go to a memory stream, never to the user's terminal; the first line of an error report
+/* Runs Qhull as qh_new_qhull does, but without its output preparation (qh_prepare_output:
+ * triangulating non-simplicial facets and marking the "good" ones, three walks over the whole facet
+ * list, about a tenth of the run on a large block). Only for runs without merging, whose facets are
+ * all simplicial (run_qhull checks). Qhull's error exit longjmps to the setjmp here, as it would to
+ * the one in qh_new_qhull: nothing of ours lives in this frame. Returns Qhull's exit code. */
+static int qhull_unmerged(qhT *qh, int dim, int32_t npts, double *coords, char *flags, FILE *err)
+{
+    int code;
+    if (!qh->qhmem.ferr)
+        qh_meminit(qh, err);
+    else
+        qh_memcheck(qh);
+    qh_initqhull_start(qh, NULL, NULL, err);
+    code = setjmp(qh->errexit);
+    if (code == 0) {
+        qh->NOerrexit = False;
+        qh_initflags(qh, flags);
+        qh->PROJECTdelaunay = qh->DELAUNAY;
+        qh_init_B(qh, coords, npts, dim, False);
+        qh_qhull(qh);
+        qh_check_output(qh);
+    }
+    qh->NOerrexit = True;
+    return code;
+}
+
+/* design: Qhull reports errors by longjmp to a setjmp inside qh_new_qhull (or qhull_unmerged), so
+ * no jump crosses our frames; we only read its facet list after a successful return and then free
+ * everything. Its messages go to a memory stream, never to the user's terminal; the first line of an error report
  * becomes our message. Delaunay: "d Qbb Qc Qz Qt" lifts to the paraboloid (last coordinate scaled,
  * a point at infinity against cospherical input, triangulated output) and the lower facets are the
  * triangles. Without `merge`, "Q0" also turns off Qhull's merging of nearly coplanar facets: a third
- * faster on evenly spaced points, which are nearly cocircular everywhere; its rare failures (a
- * Qhull precision error, or a mesh our checks reject) fall back to the merging run. Sphere: "Qt"
+ * faster on evenly spaced points, which are nearly cocircular everywhere; its facets are simplicial
+ * without Qt's pass (qhull_unmerged), and its rare failures (a Qhull precision error, a facet that
+ * is not a triangle, or a mesh our checks reject) fall back to the merging run. Sphere: "Qt"
  * convex hull, each triangle turned to agree with Qhull's outward normal. Returns triangles as point
  * indices (Delaunay triangles unoriented). */
 static int run_qhull(int dim, int32_t npts, double *coords, bool delaunay, bool merge, int32_t **tri_out,
@@ -64,7 +92,9 @@ static int run_qhull(int dim, int32_t npts, double *coords, bool delaunay, bool 
     char flags_delaunay[] = "qhull d Qbb Qc Qz Qt";
     char flags_hull[] = "qhull Qt";
     char *flags = !delaunay ? flags_hull : (merge ? flags_delaunay : flags_fast);
-    int code = qh_new_qhull(qh, dim, npts, coords, False, flags, NULL, err);
+    bool unmerged = delaunay && !merge;
+    int code = unmerged ? qhull_unmerged(qh, dim, npts, coords, flags, err)
+                        : qh_new_qhull(qh, dim, npts, coords, False, flags, NULL, err);
 
     int rc = 0;
     int32_t *tri = NULL;
@@ -72,11 +102,8 @@ static int run_qhull(int dim, int32_t npts, double *coords, bool delaunay, bool 
     if (code == 0) {
         facetT *facet;
         vertexT *vertex, **vertexp;
-        int64_t count = 0;
-        FORALLfacets {
-            if (!delaunay || !facet->upperdelaunay)
-                count++;
-        }
+        /* one walk over the facet list (it is scattered in memory): qh->num_facets bounds the count */
+        int64_t count = qh->num_facets;
         tri = fs_malloc((size_t)(count ? count : 1) * 3 * sizeof *tri);
         FORALLfacets {
             if (delaunay && facet->upperdelaunay)
@@ -92,12 +119,19 @@ static int run_qhull(int dim, int32_t npts, double *coords, bool delaunay, bool 
                     inside = false;
             }
             if (k != 3) {
-                fs_error(FS_ERR_INTERNAL, "delaunay: qhull returned a facet with %d vertices despite option Qt", k);
+                fs_error(FS_ERR_INTERNAL, "delaunay: qhull returned a facet with %d vertices %s", k,
+                         unmerged ? "without merging" : "despite option Qt");
                 rc = -1;
                 break;
             }
             if (!inside)
                 continue;
+            if (nt == count) {
+                fs_error(FS_ERR_INTERNAL, "delaunay: qhull's facet list is longer than its count of %lld",
+                         (long long)count);
+                rc = -1;
+                break;
+            }
             if (!delaunay) {
                 const double *a = coords + 3 * (size_t)ids[0], *b = coords + 3 * (size_t)ids[1],
                              *c = coords + 3 * (size_t)ids[2];
@@ -667,39 +701,43 @@ static void run_block(block_job *job)
     }
 }
 
+/* Blocks handed out in turn to whichever thread is free (they differ in cost, and a thread may
+ * be held up by other work on the machine). */
 typedef struct {
     block_job *jobs;
-    int njobs, first, stride;
-} block_worker;
+    int njobs, next;
+    pthread_mutex_t lock;
+} block_queue;
 
 static void *block_worker_main(void *arg)
 {
-    block_worker *w = arg;
-    for (int j = w->first; j < w->njobs; j += w->stride)
-        run_block(&w->jobs[j]);
-    return NULL;
+    block_queue *q = arg;
+    for (;;) {
+        pthread_mutex_lock(&q->lock);
+        int j = q->next < q->njobs ? q->next++ : -1;
+        pthread_mutex_unlock(&q->lock);
+        if (j < 0)
+            return NULL;
+        run_block(&q->jobs[j]);
+    }
 }
 
 /* Runs the blocks on up to one thread per processor; the result does not depend on the thread
- * count (each block's output depends only on the input). Without threads, runs them in turn. */
+ * count nor on which thread runs which block (each block's output depends only on the input).
+ * Threads that cannot be started leave their blocks to the others. */
 static void run_blocks(block_job *jobs, int njobs)
 {
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     int nthreads = ncpu < 1 ? 1 : (ncpu < njobs ? (int)ncpu : njobs);
-    block_worker w[MAX_BLOCKS];
+    block_queue q = {jobs, njobs, 0, PTHREAD_MUTEX_INITIALIZER};
     pthread_t thread[MAX_BLOCKS];
     bool started[MAX_BLOCKS] = {false};
-    for (int t = 0; t < nthreads; t++)
-        w[t] = (block_worker){jobs, njobs, t, nthreads};
     for (int t = 1; t < nthreads; t++)
-        started[t] = pthread_create(&thread[t], NULL, block_worker_main, &w[t]) == 0;
-    block_worker_main(&w[0]);
-    for (int t = 1; t < nthreads; t++) {
+        started[t] = pthread_create(&thread[t], NULL, block_worker_main, &q) == 0;
+    block_worker_main(&q);
+    for (int t = 1; t < nthreads; t++)
         if (started[t])
             pthread_join(thread[t], NULL);
-        else
-            block_worker_main(&w[t]);
-    }
 }
 
 typedef enum {

@@ -139,42 +139,79 @@ static void node_half_edges(const fs_mesh *m, int32_t **start_out, int32_t **lis
     *list_out = list;
 }
 
-/* Sorts keys (with their values) by an LSD radix sort on the low `bits` bits. */
-static void radix_sort(uint64_t *key, int32_t *val, int32_t n, int bits)
+/* A key with its value, for sorting the keys of a node of high degree. */
+typedef struct {
+    uint64_t key;
+    int32_t val;
+} keyed;
+
+static int keyed_cmp(const void *pa, const void *pb)
 {
-    enum { DIGIT = 11, BUCKETS = 1 << DIGIT };
-    uint64_t *key2 = fs_malloc((size_t)(n ? n : 1) * sizeof *key2);
-    int32_t *val2 = fs_malloc((size_t)(n ? n : 1) * sizeof *val2);
-    int32_t *count = fs_malloc(BUCKETS * sizeof *count);
-    for (int shift = 0; shift < bits; shift += DIGIT) {
-        memset(count, 0, BUCKETS * sizeof *count);
-        for (int32_t i = 0; i < n; i++)
-            count[(key[i] >> shift) & (BUCKETS - 1)]++;
-        int32_t sum = 0;
-        for (int d = 0; d < BUCKETS; d++) {
-            int32_t c = count[d];
-            count[d] = sum;
-            sum += c;
-        }
-        for (int32_t i = 0; i < n; i++) {
-            int32_t k = count[(key[i] >> shift) & (BUCKETS - 1)]++;
-            key2[k] = key[i];
-            val2[k] = val[i];
-        }
-        memcpy(key, key2, (size_t)n * sizeof *key);
-        memcpy(val, val2, (size_t)n * sizeof *val);
-    }
-    free(key2);
-    free(val2);
-    free(count);
+    const keyed *a = pa, *b = pb;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->val > b->val) - (a->val < b->val);
 }
 
-/* design: every half-edge gets the key (smaller node, larger node, direction); a radix sort brings
- * the two half-edges of an edge together (sequential passes, no random access per half-edge), and
- * a run of equal node pairs is matched by image offset and direction: a partner runs the other way
- * with the opposite offset. Runs longer than two are rare: tiny periodic meshes, where one pair of nodes
- * has several edges, or a non-manifold mesh. A second half-edge along the same edge in the same
- * direction means three triangles on one edge or two facing opposite ways. */
+/* Sorts keys (with their values, which are ascending on entry) stably: keys are
+ * (node << low_bits | rest) with node < n_nodes. A counting sort on the node (one pass), then an
+ * insertion sort within each node's few keys (a sort by key and value for a node of high degree,
+ * which is the same order). */
+static void sort_node_keys(uint64_t *key, int32_t *val, int32_t n, int low_bits, int32_t n_nodes)
+{
+    int32_t *start = fs_calloc((size_t)n_nodes + 1, sizeof *start);
+    for (int32_t i = 0; i < n; i++)
+        start[(key[i] >> low_bits) + 1]++;
+    for (int32_t v = 0; v < n_nodes; v++)
+        start[v + 1] += start[v];
+    uint64_t *key2 = fs_malloc((size_t)(n ? n : 1) * sizeof *key2);
+    int32_t *val2 = fs_malloc((size_t)(n ? n : 1) * sizeof *val2);
+    for (int32_t i = 0; i < n; i++) {
+        int32_t k = start[key[i] >> low_bits]++;
+        key2[k] = key[i];
+        val2[k] = val[i];
+    }
+    for (int32_t v = 0, i0 = 0; v < n_nodes; v++) {
+        int32_t i1 = start[v];
+        if (i1 - i0 > 32) {
+            keyed *kv = fs_malloc((size_t)(i1 - i0) * sizeof *kv);
+            for (int32_t i = i0; i < i1; i++)
+                kv[i - i0] = (keyed){key2[i], val2[i]};
+            qsort(kv, (size_t)(i1 - i0), sizeof *kv, keyed_cmp);
+            for (int32_t i = i0; i < i1; i++) {
+                key2[i] = kv[i - i0].key;
+                val2[i] = kv[i - i0].val;
+            }
+            free(kv);
+            i0 = i1;
+            continue;
+        }
+        for (int32_t i = i0 + 1; i < i1; i++) {
+            uint64_t k = key2[i];
+            int32_t x = val2[i], p = i;
+            for (; p > i0 && key2[p - 1] > k; p--) {
+                key2[p] = key2[p - 1];
+                val2[p] = val2[p - 1];
+            }
+            key2[p] = k;
+            val2[p] = x;
+        }
+        i0 = i1;
+    }
+    memcpy(key, key2, (size_t)n * sizeof *key);
+    memcpy(val, val2, (size_t)n * sizeof *val);
+    free(key2);
+    free(val2);
+    free(start);
+}
+
+/* design: every half-edge gets the key (smaller node, larger node, direction); a stable sort of
+ * the keys (sort_node_keys: one counting pass on the smaller node, then a node's few keys) brings
+ * the two half-edges of an edge together, and a run of equal node pairs is matched by image
+ * offset and direction: a partner runs the other way with the opposite offset. Runs longer than
+ * two are rare: tiny periodic meshes, where one pair of nodes has several edges, or a non-manifold
+ * mesh. A second half-edge along the same edge in the same direction means three triangles on one
+ * edge or two facing opposite ways. */
 int fs_mesh_build_adjacency(fs_mesh *m)
 {
     if ((int64_t)m->n_tris * 3 > INT32_MAX) {
@@ -199,7 +236,7 @@ int fs_mesh_build_adjacency(fs_mesh *m)
         val[h] = h;
         m->adj[h] = -1;
     }
-    radix_sort(key, val, nh, 2 * bits + 1);
+    sort_node_keys(key, val, nh, bits + 1, m->n_nodes);
 
     int rc = 0;
     for (int32_t i = 0; i < nh && rc == 0;) {

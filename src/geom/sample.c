@@ -2,8 +2,10 @@
 #include "geom/sample.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdbool.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "base/error.h"
 #include "base/rng.h"
@@ -152,6 +154,8 @@ typedef struct {
     int32_t *sid;
     int32_t *start;    /* n_buckets + 1 */
     double *f[3];      /* force on each particle of the snapshot */
+    int nthreads;      /* threads, and tasks of the per-particle passes (see MAX_THREADS) */
+    int32_t *tcount;   /* nthreads * n_buckets: bucket counts of each task's particles */
 } relax_state;
 
 static int32_t cell_coord(double v, double origin, double inv, int32_t dim)
@@ -206,29 +210,141 @@ static int32_t particle_bucket(const relax_state *s, int32_t i)
     return best;
 }
 
-/* Stable counting sort of the particles into buckets. */
-static void bucket_sort(relax_state *s)
+/* design: the passes of an iteration run on up to one thread per processor (MAX_THREADS), and the
+ * result does not depend on the thread count: per-particle passes split the particles into
+ * contiguous ranges, the bucket sort stays stable (each range counts its own buckets, and a range's
+ * particles go after those of the ranges before it), and the force pass keeps the sequential order
+ * of every floating-point sum (see all_forces). */
+#define MAX_THREADS 8
+/* The force pass is cut into this many bands per thread, so that a thread held up by other work
+ * on the machine delays the pass by a smaller share. */
+#define BANDS_PER_THREAD 4
+#define MAX_BANDS (BANDS_PER_THREAD * MAX_THREADS)
+/* Below this many particles everything runs on the calling thread. */
+#define PARALLEL_MIN_COUNT 20000
+
+/* A force on snapshot particle j, kept back by a force task (see all_forces). */
+typedef struct {
+    int32_t j;
+    double v[3];
+} force_entry;
+
+/* One task of a parallel pass: particles [i0, i1), or grid rows [row0, row1) for the forces. */
+typedef struct {
+    relax_state *s;
+    int t;
+    int32_t i0, i1;
+    int32_t row0, row1;
+    int32_t log_below;  /* forces on snapshot particles before this index go to the log */
+    force_entry *log;   /* those forces, in the order this task computed them */
+    int32_t n_log, cap_log;
+    double step, maxmove;
+} relax_task;
+
+/* Tasks handed out in turn to whichever thread is free. */
+typedef struct {
+    void *(*fn)(void *);
+    relax_task *task;
+    int n_tasks, next;
+    pthread_mutex_t lock;
+} task_queue;
+
+static void *task_worker(void *arg)
 {
-    int32_t n = s->n, nb = s->n_buckets;
-    int dims = s->sphere ? 3 : 2;
-    memset(s->start, 0, (size_t)(nb + 1) * sizeof *s->start);
-    for (int32_t i = 0; i < n; i++) {
+    task_queue *q = arg;
+    for (;;) {
+        pthread_mutex_lock(&q->lock);
+        int t = q->next < q->n_tasks ? q->next++ : -1;
+        pthread_mutex_unlock(&q->lock);
+        if (t < 0)
+            return NULL;
+        q->fn(&q->task[t]);
+    }
+}
+
+/* Runs fn on tasks [0, n_tasks) on the calling thread and up to nthreads - 1 more (a thread that
+ * cannot be started leaves its share to the others). */
+static void run_tasks(void *(*fn)(void *), relax_task *task, int n_tasks, int nthreads)
+{
+    task_queue q = {fn, task, n_tasks, 0, PTHREAD_MUTEX_INITIALIZER};
+    pthread_t thread[MAX_THREADS];
+    bool started[MAX_THREADS] = {false};
+    for (int t = 1; t < nthreads && t < n_tasks; t++)
+        started[t] = pthread_create(&thread[t], NULL, task_worker, &q) == 0;
+    task_worker(&q);
+    for (int t = 1; t < nthreads && t < n_tasks; t++)
+        if (started[t])
+            pthread_join(thread[t], NULL);
+}
+
+/* Splits the particles into s->nthreads contiguous ranges. */
+static void particle_tasks(relax_state *s, relax_task *task)
+{
+    for (int t = 0; t < s->nthreads; t++) {
+        memset(&task[t], 0, sizeof task[t]);
+        task[t].s = s;
+        task[t].t = t;
+        task[t].i0 = (int32_t)((int64_t)s->n * t / s->nthreads);
+        task[t].i1 = (int32_t)((int64_t)s->n * (t + 1) / s->nthreads);
+    }
+}
+
+/* Bucket sort, first pass: the bucket of each particle of the range, counted per range. */
+static void *sort_keys(void *arg)
+{
+    relax_task *task = arg;
+    relax_state *s = task->s;
+    int32_t *count = s->tcount + (size_t)task->t * (size_t)s->n_buckets;
+    memset(count, 0, (size_t)s->n_buckets * sizeof *count);
+    for (int32_t i = task->i0; i < task->i1; i++) {
         int32_t b = particle_bucket(s, i);
         s->key[i] = b;
-        s->start[b + 1]++;
+        count[b]++;
     }
-    for (int32_t b = 0; b < nb; b++)
-        s->start[b + 1] += s->start[b];
-    for (int32_t i = 0; i < n; i++) {
-        int32_t k = s->start[s->key[i]]++;
+    return NULL;
+}
+
+/* Bucket sort, last pass: each particle of the range to its place in the snapshot (its range's
+ * count array now holds where the range's next particle of each bucket goes); clears the forces. */
+static void *sort_scatter(void *arg)
+{
+    relax_task *task = arg;
+    relax_state *s = task->s;
+    int dims = s->sphere ? 3 : 2;
+    int32_t *next = s->tcount + (size_t)task->t * (size_t)s->n_buckets;
+    for (int32_t i = task->i0; i < task->i1; i++) {
+        int32_t k = next[s->key[i]]++;
         for (int a = 0; a < dims; a++)
             s->sx[a][k] = s->x[a][i];
         s->sr[k] = s->r[i];
         s->sid[k] = s->id[i];
     }
-    for (int32_t b = nb; b > 0; b--)
-        s->start[b] = s->start[b - 1];
-    s->start[0] = 0;
+    for (int a = 0; a < dims; a++)
+        memset(s->f[a] + task->i0, 0, (size_t)(task->i1 - task->i0) * sizeof(double));
+    return NULL;
+}
+
+/* Stable counting sort of the particles into buckets (the snapshot and start), with the forces
+ * cleared for the next force pass. */
+static void bucket_sort(relax_state *s)
+{
+    relax_task task[MAX_THREADS];
+    int32_t nb = s->n_buckets;
+    int nt = s->nthreads;
+    particle_tasks(s, task);
+    run_tasks(sort_keys, task, nt, nt);
+    int32_t sum = 0;
+    for (int32_t b = 0; b < nb; b++) {
+        s->start[b] = sum;
+        for (int t = 0; t < nt; t++) {
+            int32_t *c = s->tcount + (size_t)t * (size_t)nb + b;
+            int32_t count = *c;
+            *c = sum;
+            sum += count;
+        }
+    }
+    s->start[nb] = sum;
+    run_tasks(sort_scatter, task, nt, nt);
 }
 
 /* Appends particles [j0, j1) with a shift to a list of ranges, merging it into the last range when
@@ -339,11 +455,26 @@ static double coincident_push(const relax_state *s, int32_t k, int32_t j)
     return s->sid[k] > s->sid[j] ? 0.5 : -0.5;
 }
 
+/* Appends a force on snapshot particle j to a task's log. */
+static void log_force(relax_task *task, int32_t j, const double *v)
+{
+    if (task->n_log == task->cap_log) {
+        task->cap_log = task->cap_log ? 2 * task->cap_log : 1024;
+        task->log = fs_realloc(task->log, (size_t)task->cap_log * sizeof *task->log);
+    }
+    force_entry *e = &task->log[task->n_log++];
+    e->j = j;
+    for (int a = 0; a < 3; a++)
+        e->v[a] = v[a];
+}
+
 /* Adds the forces of the first c gathered pairs to particle k and, reversed, to their partners
  * (never k itself: the half stencil starts after k in its own cell, and k's periodic images are not
- * at distance 0). The force magnitude is 1 - (d / rsum)^2 along the line between the two. */
-static inline void pair_forces(relax_state *s, const hit_list *h, int c, int32_t k, int dims)
+ * at distance 0). The force magnitude is 1 - (d / rsum)^2 along the line between the two. A force
+ * on a particle before task->log_below is logged instead (as the negated term: x - y is x + (-y)). */
+static inline void pair_forces(relax_task *task, const hit_list *h, int c, int32_t k, int dims)
 {
+    relax_state *s = task->s;
     double fk[3] = {0.0, 0.0, 0.0};
     for (int q = 0; q < c; q++) {
         int32_t j = h->j[q];
@@ -359,20 +490,32 @@ static inline void pair_forces(relax_state *s, const hit_list *h, int c, int32_t
             g = 0.0;
             push = coincident_push(s, k, j);
         }
+        double fa[3] = {0.0, 0.0, 0.0};
         for (int a = 0; a < dims; a++) {
-            double fa = g * h->d[a][q] + push;
-            fk[a] += fa;
-            s->f[a][j] -= fa;
+            fa[a] = g * h->d[a][q] + push;
+            fk[a] += fa[a];
+        }
+        if (j >= task->log_below) {
+            for (int a = 0; a < dims; a++)
+                s->f[a][j] -= fa[a];
+        } else {
+            double neg[3] = {-fa[0], -fa[1], -fa[2]};
+            log_force(task, j, neg);
         }
     }
-    for (int a = 0; a < dims; a++)
-        s->f[a][k] += fk[a];
+    if (k >= task->log_below) {
+        for (int a = 0; a < dims; a++)
+            s->f[a][k] += fk[a];
+    } else {
+        log_force(task, k, fk);
+    }
 }
 
 /* Adds the forces between particle k and the particles of ranges nb[0..m). */
-static inline void particle_forces(relax_state *s, int32_t k, const neighbour *nb, int m, int dims)
+static inline void particle_forces(relax_task *task, int32_t k, const neighbour *nb, int m, int dims)
 {
     hit_list hit;
+    const relax_state *s = task->s;
     const double *sx = s->sx[0], *sy = s->sx[1], *sz = s->sx[2], *sr = s->sr;
     double xi = sx[k], yi = sy[k], zi = dims == 3 ? sz[k] : 0.0, ri = sr[k];
     int c = 0;
@@ -392,34 +535,41 @@ static inline void particle_forces(relax_state *s, int32_t k, const neighbour *n
             double rs = ri + sr[j];
             c += d2 < rs * rs;
             if (c == HIT_CHUNK) {
-                pair_forces(s, &hit, c, k, dims);
+                pair_forces(task, &hit, c, k, dims);
                 c = 0;
             }
         }
     }
-    pair_forces(s, &hit, c, k, dims);
+    pair_forces(task, &hit, c, k, dims);
 }
 
 /* The same, specialised for 2-D and 3-D (dims a constant in the inner loops). */
-static void particle_forces_2d(relax_state *s, int32_t k, const neighbour *nb, int m)
+static void particle_forces_2d(relax_task *task, int32_t k, const neighbour *nb, int m)
 {
-    particle_forces(s, k, nb, m, 2);
+    particle_forces(task, k, nb, m, 2);
 }
 
-static void particle_forces_3d(relax_state *s, int32_t k, const neighbour *nb, int m)
+static void particle_forces_3d(relax_task *task, int32_t k, const neighbour *nb, int m)
 {
-    particle_forces(s, k, nb, m, 3);
+    particle_forces(task, k, nb, m, 3);
 }
 
-/* Forces on every particle of the snapshot, cell by cell in bucket order. */
-static void all_forces(relax_state *s)
+/* The first bucket of grid row iy (iy = dim[1]: the number of buckets). */
+static int32_t row_bucket(const relax_state *s, int32_t iy)
 {
-    int dims = s->sphere ? 3 : 2;
+    if (iy >= s->dim[1])
+        return s->n_buckets;
+    return s->sphere ? s->col[(size_t)iy * (size_t)s->dim[0]].base : iy * s->dim[0];
+}
+
+/* Forces from the cells of rows [row0, row1), cell by cell in bucket order. */
+static void *row_forces(void *arg)
+{
+    relax_task *task = arg;
+    relax_state *s = task->s;
     neighbour nb[MAX_RANGES];
-    for (int a = 0; a < dims; a++)
-        memset(s->f[a], 0, (size_t)s->n * sizeof(double));
-    int32_t b = 0;
-    for (int32_t iy = 0; iy < s->dim[1]; iy++)
+    int32_t b = row_bucket(s, task->row0);
+    for (int32_t iy = task->row0; iy < task->row1; iy++)
         for (int32_t ix = 0; ix < s->dim[0]; ix++) {
             int runs = 1;
             const shell_column *col = NULL;
@@ -443,14 +593,62 @@ static void all_forces(relax_state *s)
                     for (int32_t k = k0; k < k1; k++) {
                         nb[0].j0 = k + 1;
                         if (s->sphere)
-                            particle_forces_3d(s, k, nb, m);
+                            particle_forces_3d(task, k, nb, m);
                         else
-                            particle_forces_2d(s, k, nb, m);
+                            particle_forces_2d(task, k, nb, m);
                     }
                 }
             }
         }
-    FS_ASSERT(b == s->n_buckets);
+    FS_ASSERT(b == row_bucket(s, task->row1));
+    return NULL;
+}
+
+/* design: forces on every particle of the snapshot (cleared by bucket_sort), summed in the order of
+ * one sequential pass over the cells in bucket order, whatever the thread count. The grid rows are
+ * cut into bands of about equal particle counts, one task each (BANDS_PER_THREAD). A row's half stencil reaches only
+ * its own row and the row above (the top row wraps to row 0 when y is periodic), so the particles
+ * of a band's first row also get forces from the band below, which come first in the sequential
+ * order, and row 0 gets forces from the top band, which come last. Each band but the first logs its
+ * forces on particles up to the end of its first row (row 0 included) instead of adding them, and
+ * the logs are replayed band by band after all bands are done; every other particle gets forces
+ * from one band only. So no two tasks write one particle, and every sum is added up in the same
+ * order as in one pass. */
+static void all_forces(relax_state *s)
+{
+    relax_task task[MAX_BANDS];
+    int32_t rows[MAX_BANDS + 1];
+    int bands = s->nthreads > 1 ? BANDS_PER_THREAD * s->nthreads : 1;
+    int nt = 0;
+    rows[0] = 0;
+    for (int t = 1; t < bands; t++) {
+        int32_t target = (int32_t)((int64_t)s->n * t / bands);
+        int32_t r = rows[nt] + 1;
+        while (r < s->dim[1] && s->start[row_bucket(s, r)] < target)
+            r++;
+        if (r >= s->dim[1])
+            break;
+        rows[++nt] = r;
+    }
+    rows[++nt] = s->dim[1];
+    for (int t = 0; t < nt; t++) {
+        memset(&task[t], 0, sizeof task[t]);
+        task[t].s = s;
+        task[t].t = t;
+        task[t].row0 = rows[t];
+        task[t].row1 = rows[t + 1];
+        task[t].log_below = t == 0 ? 0 : s->start[row_bucket(s, rows[t] + 1)];
+    }
+    run_tasks(row_forces, task, nt, s->nthreads);
+    int dims = s->sphere ? 3 : 2;
+    for (int t = 1; t < nt; t++) {
+        for (int32_t e = 0; e < task[t].n_log; e++) {
+            const force_entry *fe = &task[t].log[e];
+            for (int a = 0; a < dims; a++)
+                s->f[a][fe->j] += fe->v[a];
+        }
+        free(task[t].log);
+    }
 }
 
 /* Moves a coordinate by dv: wraps on a periodic side, snaps to a non-periodic one. */
@@ -469,13 +667,14 @@ static double move_coord(double v, double dv, double ext, bool periodic)
     return v < 0.0 ? 0.0 : (v > ext ? ext : v);
 }
 
-/* One Jacobi iteration: forces from the snapshot, then every particle moves by step * force, capped
- * at maxmove, and is brought back into the domain. */
-static void relax_step(relax_state *s, double step, double maxmove)
+/* Moves the particles of a task's range by step * force, capped at maxmove, back into the domain. */
+static void *move_particles(void *arg)
 {
+    relax_task *task = arg;
+    relax_state *s = task->s;
     int dims = s->sphere ? 3 : 2;
-    all_forces(s);
-    for (int32_t k = 0; k < s->n; k++) {
+    double step = task->step, maxmove = task->maxmove;
+    for (int32_t k = task->i0; k < task->i1; k++) {
         double mv[3] = {0.0, 0.0, 0.0}, l2 = 0.0;
         for (int a = 0; a < dims; a++) {
             mv[a] = step * s->f[a][k];
@@ -497,6 +696,21 @@ static void relax_step(relax_state *s, double step, double maxmove)
         s->r[k] = s->sr[k];
         s->id[k] = s->sid[k];
     }
+    return NULL;
+}
+
+/* One Jacobi iteration: forces from the snapshot, then every particle moves by step * force, capped
+ * at maxmove, and is brought back into the domain. */
+static void relax_step(relax_state *s, double step, double maxmove)
+{
+    relax_task task[MAX_THREADS];
+    all_forces(s);
+    particle_tasks(s, task);
+    for (int t = 0; t < s->nthreads; t++) {
+        task[t].step = step;
+        task[t].maxmove = maxmove;
+    }
+    run_tasks(move_particles, task, s->nthreads, s->nthreads);
 }
 
 static int32_t cells_along(double ext, double dmax)
@@ -580,6 +794,7 @@ static void free_state(relax_state *s)
     free(s->sr);
     free(s->sid);
     free(s->start);
+    free(s->tcount);
     free(s->col);
 }
 
@@ -651,6 +866,9 @@ int fs_sample_repulsion(const fs_domain *domain, const fs_sample_params *params,
     else
         setup_grid_2d(&s, dmax);
     s.start = fs_malloc(((size_t)s.n_buckets + 1) * sizeof *s.start);
+    long ncpu = n >= PARALLEL_MIN_COUNT ? sysconf(_SC_NPROCESSORS_ONLN) : 1;
+    s.nthreads = ncpu < 1 ? 1 : (ncpu > MAX_THREADS ? MAX_THREADS : (int)ncpu);
+    s.tcount = fs_malloc((size_t)s.nthreads * (size_t)s.n_buckets * sizeof *s.tcount);
 
     int iters = params->iterations;
     for (int it = 0; it < iters; it++) {

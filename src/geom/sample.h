@@ -26,7 +26,8 @@ typedef struct {
 
 /* Particle repulsion: places params->count points, roughly evenly spaced, on the domain. Cost is
  * O(count * iterations) through a uniform grid of cells about one force radius wide. Periodic
- * directions wrap. Deterministic for a given seed. Returns 0, or -1 with fs_error(FS_ERR_DATA, ...)
+ * directions wrap. Deterministic for a given seed, whatever the number of threads (a large set is
+ * sampled on up to one thread per processor). Returns 0, or -1 with fs_error(FS_ERR_DATA, ...)
  * for an impossible request (count < 3, too many points for memory, a degenerate domain). */
 int fs_sample_repulsion(const fs_domain *d, const fs_sample_params *params, fs_points *out);
 

@@ -24,6 +24,7 @@ _Static_assert(sizeof(fs_growth_type) == sizeof(int), "enum fs_growth_type is in
 _Static_assert(sizeof(fs_fracture_method) == sizeof(int), "enum fs_fracture_method is int-sized");
 _Static_assert(sizeof(fs_normal_convention) == sizeof(int), "enum fs_normal_convention is int-sized");
 _Static_assert(sizeof(fs_solver_method) == sizeof(int), "enum fs_solver_method is int-sized");
+_Static_assert(sizeof(fs_relax_mode) == sizeof(int), "enum fs_relax_mode is int-sized");
 _Static_assert(_Generic((int32_t)0, int: 1, default: 0), "int32_t is int");
 
 typedef enum {
@@ -67,6 +68,7 @@ static const char *const growth_words[] = {"none", "planar", "cylinder", "sphere
 static const char *const method_words[] = {"split", "remove", NULL};
 static const char *const normal_words[] = {"opengl", "directx", NULL};
 static const char *const solver_words[] = {"cholmod", "cg", NULL};
+static const char *const relax_words[] = {"auto", "global", "local", NULL};
 static const char *const post_words[] = {"glue", "curl", "flat", NULL};
 
 #define OFF(field) offsetof(fs_config, field)
@@ -138,6 +140,9 @@ static const key_def key_table[] = {
     {"solver", "method", KEY_WORD, OFF(solver.method), 0, 0, 0, solver_words, NULL},
     {"solver", "tolerance", KEY_REAL, OFF(solver.tolerance), 0, 0.1, GT | LE, NULL, NULL},
     {"solver", "max_iterations", KEY_INT, OFF(solver.max_iterations), 0, 1000000000, GE | LE, NULL, NULL},
+    {"solver", "relax", KEY_WORD, OFF(solver.relax), 0, 0, 0, relax_words, NULL},
+    {"solver", "relax_radius", KEY_REAL, OFF(solver.relax_radius), 1, 1e6, GE | LE, NULL, "edge lengths"},
+    {"solver", "relax_tolerance", KEY_REAL, OFF(solver.relax_tolerance), 0, 0.1, GT | LE, NULL, NULL},
 
     {"wedge", "thickness_gradient", KEY_REAL, OFF(wedge.thickness_gradient), -1.9, 1.9, GE | LE, NULL, NULL},
 

@@ -4,6 +4,7 @@
 #include "config.h"
 
 #include <jansson.h>
+#include <stdbool.h>
 #include <string.h>
 
 #include "base/error.h"
@@ -63,9 +64,11 @@ static json_t *map_entry(const fs_sidecar_map *m, const fs_config *cfg, const fs
     json_object_set_new(e, "channels", json_integer(m->image->channels));
     json_object_set_new(e, "width", json_integer(m->image->width));
     json_object_set_new(e, "height", json_integer(m->image->height));
+    /* a perspective view of the object never tiles, whatever the domain does */
+    bool texture_space = strcmp(m->kind, "preview") != 0;
     json_t *tile = json_object();
-    json_object_set_new(tile, "u", json_boolean(fs_domain_wraps_u(&d)));
-    json_object_set_new(tile, "v", json_boolean(fs_domain_wraps_v(&d)));
+    json_object_set_new(tile, "u", json_boolean(texture_space && fs_domain_wraps_u(&d)));
+    json_object_set_new(tile, "v", json_boolean(texture_space && fs_domain_wraps_v(&d)));
     json_object_set_new(e, "tileable", tile);
     if (!strcmp(m->kind, "height")) {
         json_object_set_new(e, "height_min_cm", json_real(maps->height_min_cm));
@@ -92,7 +95,7 @@ static json_t *map_entry(const fs_sidecar_map *m, const fs_config *cfg, const fs
 
 int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_text, const fs_stats *stats,
                      const fs_maps *maps, const char *target, const fs_sidecar_map *list, int n_maps,
-                     double wall_seconds)
+                     const fs_sidecar_frames *frames, double wall_seconds)
 {
     json_t *root = json_object();
     json_object_set_new(root, "generator", json_string("fissure"));
@@ -125,6 +128,34 @@ int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_
     for (int i = 0; i < n_maps; i++)
         json_object_set_new(jm, list[i].kind, map_entry(&list[i], cfg, maps));
     json_object_set_new(root, "maps", jm);
+
+    if (frames) {
+        json_t *jf = json_object();
+        json_object_set_new(jf, "count", json_integer(frames->count));
+        json_object_set_new(jf, "file_pattern", json_string(frames->file_pattern));
+        json_t *kinds = json_object();
+        for (int i = 0; i < frames->n_maps; i++) {
+            json_t *e = map_entry(&frames->map[i], cfg, maps);
+            /* each frame's height map has its own range, listed per frame below */
+            json_object_del(e, "height_min_cm");
+            json_object_del(e, "height_max_cm");
+            json_object_del(e, "height_scale_cm");
+            json_object_set_new(kinds, frames->map[i].kind, e);
+        }
+        json_object_set_new(jf, "maps", kinds);
+        json_t *list_f = json_array();
+        for (int32_t k = 0; k < frames->count; k++) {
+            json_t *f = json_object();
+            json_object_set_new(f, "frame", json_integer(k + 1));
+            json_object_set_new(f, "time", json_real(frames->time[k]));
+            json_object_set_new(f, "fractures", json_integer(frames->fractures[k]));
+            json_object_set_new(f, "height_min_cm", json_real(frames->height_min_cm[k]));
+            json_object_set_new(f, "height_max_cm", json_real(frames->height_max_cm[k]));
+            json_array_append_new(list_f, f);
+        }
+        json_object_set_new(jf, "frames", list_f);
+        json_object_set_new(root, "frames", jf);
+    }
 
     int rc = json_dump_file(root, path, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10));
     json_decref(root);

@@ -387,6 +387,7 @@ static int factorize(fs_wedge_model *w, bool analyze)
     w->counters.factor_seconds += t2 - t1;
     w->counters.factorizations++;
     w->updowns_pending = 0;
+    w->factor_stale = rc < 0;
     return rc;
 }
 
@@ -618,6 +619,33 @@ static void strain_from_gradients(const double dndx[18], const double u[18], dou
     strain[5] = g[2][0] + g[0][2];
 }
 
+/* design: a bound of how fast an element's ratio can change with its nodal displacements u_e, for
+ * the lazy re-evaluation in element_ratios. The stress at a Gauss point is linear in u_e, sigma = E D B
+ * u_e + const, and the largest eigenvalue of a symmetric tensor moves by at most the spectral norm of
+ * the change (Weyl), which is at most its Frobenius norm, at most ||W D B||_F ||du_e|| (W weighs the
+ * Voigt shears by sqrt 2 to give the tensor norm). The largest over the three top Gauss points, times
+ * E over the threshold. */
+static double ratio_lipschitz(const fs_wedge_model *w, int32_t e, const double *cache)
+{
+    double worst = 0.0;
+    for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
+        double sum = 0.0;
+        for (int a = 0; a < 18; a++) {
+            double unit[18] = {0}, strain[6];
+            unit[a] = 1.0;
+            strain_from_gradients(cache + 18 * g, unit, strain);
+            for (int i = 0; i < 6; i++) {
+                double s = 0.0;
+                for (int j = 0; j < 6; j++)
+                    s += w->d_unit[6 * i + j] * strain[j];
+                sum += (i < 3 ? 1.0 : 2.0) * s * s;
+            }
+        }
+        worst = fmax(worst, sqrt(sum));
+    }
+    return worst * w->young[e] / w->threshold[e];
+}
+
 static int refresh_cache(fs_wedge_model *w, const int32_t *elems, int32_t n)
 {
     for (int32_t q = 0; q < n; q++) {
@@ -637,9 +665,18 @@ static int refresh_cache(fs_wedge_model *w, const int32_t *elems, int32_t n)
             for (int k = 0; k < 3; k++)
                 strain_from_gradients(dndx, pat[k], c + 54 + 18 * g + 6 * k);
         }
+        w->ratio_lipschitz[e] = ratio_lipschitz(w, e, c);
+        w->ratio_ref_bound[e] = NAN;
     }
     return 0;
 }
+
+/* Lazy ratio bounds (element_ratios) above this are evaluated in full: below 1 by more than the tie
+ * tolerance of fracture/rank.h, so a lazy bound never joins a tie with a maximum over 1. */
+#define LAZY_LEVEL (1.0 - 4.0 * FS_RANK_TIE_REL)
+
+/* Relative allowance for rounding in a lazy ratio bound. */
+#define LAZY_MARGIN 1e-9
 
 /* Relative margin added to the closed-form largest eigenvalue so that it bounds the exact one: the
  * trigonometric formula loses up to about sqrt(machine epsilon) of the deviator's size when the
@@ -705,18 +742,44 @@ static int cmp_bound_desc(const void *a, const void *b)
  * has it (fracture/rank.h, ties within FS_RANK_TIE_REL), so the shared eigen kernel runs only on the
  * elements whose upper bound (principal_bound) could reach the largest exact ratio, in descending order of the
  * bound, until the next bound falls below the best exact ratio found (less the tie tolerance). Every
- * other ratio holds its bound. */
-static int element_ratios(fs_wedge_model *w)
+ * other ratio holds its bound.
+ * With lazy_ratios, an element evaluated before at the same shrinkage and eigenstrain is not evaluated
+ * again while its old bound plus ratio_lipschitz times the change of its nodal displacements stays at
+ * most LAZY_LEVEL: that sum bounds the exact ratio too. After a removal the displacements change
+ * little away from the crack tip (within a few layer thicknesses), so most elements are skipped. Every
+ * element that could be over 1 or tie with a maximum over 1 still gets its full bound, so the
+ * candidates, the exact ratios and the decisions are the same as without. */
+static int element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_elems)
 {
     double t0 = fs_seconds();
     int32_t n_over = 0;
-    for (int32_t e = 0; e < w->n_elems; e++) {
+    double coef[FS_WEDGE_PATTERNS] = {w->shrink_coef[0], w->shrink_coef[1], w->shrink_coef[2],
+                                      w->eigenstrain[0], w->eigenstrain[1], w->eigenstrain[2]};
+    if (memcmp(coef, w->ratio_ref_coef, sizeof coef) != 0) {
+        for (int32_t e = 0; e < w->n_elems; e++)
+            w->ratio_ref_bound[e] = NAN;
+        memcpy(w->ratio_ref_coef, coef, sizeof coef);
+    }
+    for (int32_t q = 0; q < n_elems; q++) {
+        int32_t e = elems ? elems[q] : q;
         if (w->state[e] != FS_WEDGE_ALIVE) {
             w->ratio[e] = NAN;
             continue;
         }
         double ue[18];
         gather_u(w, e, ue);
+        double *ref_u = w->ratio_ref_u + 18 * (size_t)e;
+        if (w->lazy_ratios && !isnan(w->ratio_ref_bound[e])) {
+            double d2 = 0.0;
+            for (int a = 0; a < 18; a++)
+                d2 += (ue[a] - ref_u[a]) * (ue[a] - ref_u[a]);
+            double ref = w->ratio_ref_bound[e];
+            double lazy = ref + w->ratio_lipschitz[e] * sqrt(d2) + LAZY_MARGIN * fabs(ref);
+            if (lazy <= LAZY_LEVEL) {
+                w->ratio[e] = lazy;
+                continue;
+            }
+        }
         const double *c = w->gauss_cache + GAUSS_CACHE * (size_t)e;
         double *st = w->stress_top + 18 * (size_t)e, bound = -INFINITY;
         for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
@@ -729,9 +792,11 @@ static int element_ratios(fs_wedge_model *w)
             bound = fmax(bound, principal_bound(st + 6 * g, w->threshold[e]));
         }
         w->ratio[e] = bound / w->threshold[e];
-        if (w->ratio[e] > 1.0)
-            n_over++;
+        w->ratio_ref_bound[e] = w->ratio[e];
+        memcpy(ref_u, ue, sizeof ue);
     }
+    for (int32_t e = 0; e < w->n_elems; e++)
+        n_over += w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0;
     if (n_over > 0) {
         bound_entry *list = fs_malloc((size_t)n_over * sizeof *list);
         int32_t n = 0;
@@ -775,7 +840,7 @@ int fs_wedge_equilibrium(fs_wedge_model *w, double t)
     }
     fixed_displacements(w, t);
     build_rhs(w);
-    if (solve(w) < 0)
+    if ((w->factor_stale && factorize(w, false) < 0) || solve(w) < 0)
         return -1;
     for (int32_t i = 0; i < w->n_nodes; i++)
         for (int l = 0; l < 6; l++) {
@@ -783,7 +848,23 @@ int fs_wedge_equilibrium(fs_wedge_model *w, double t)
             w->u[6 * (size_t)i + l] = g < w->n_free ? w->x[g] : w->u_fixed[g - w->n_free];
         }
     w->time = t;
-    return element_ratios(w);
+    return element_ratios(w, NULL, w->n_elems);
+}
+
+int fs_wedge_update_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n)
+{
+    return element_ratios(w, elems, elems ? n : w->n_elems);
+}
+
+void fs_wedge_prescribe_fixed(fs_wedge_model *w)
+{
+    fixed_displacements(w, w->time);
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        for (int l = 0; l < 6; l++) {
+            int32_t g = w->dof[6 * (size_t)i + l];
+            if (g >= w->n_free)
+                w->u[6 * (size_t)i + l] = w->u_fixed[g - w->n_free];
+        }
 }
 
 double fs_wedge_max_ratio(const fs_wedge_model *w)
@@ -857,10 +938,16 @@ static void grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
     w->ratio = fs_realloc(w->ratio, ne * sizeof *w->ratio);
     w->stress_top = fs_realloc(w->stress_top, 18 * ne * sizeof *w->stress_top);
     w->gauss_cache = fs_realloc(w->gauss_cache, GAUSS_CACHE * ne * sizeof *w->gauss_cache);
+    w->ratio_lipschitz = fs_realloc(w->ratio_lipschitz, ne * sizeof *w->ratio_lipschitz);
+    w->ratio_ref_bound = fs_realloc(w->ratio_ref_bound, ne * sizeof *w->ratio_ref_bound);
+    w->ratio_ref_u = fs_realloc(w->ratio_ref_u, 18 * ne * sizeof *w->ratio_ref_u);
     for (size_t e = (size_t)w->n_elems; e < ne; e++) {
         w->state[e] = FS_WEDGE_ALIVE;
         w->ratio[e] = NAN;
         memset(w->stress_top + 18 * e, 0, 18 * sizeof *w->stress_top);
+        w->ratio_lipschitz[e] = 0.0;
+        w->ratio_ref_bound[e] = NAN;
+        memset(w->ratio_ref_u + 18 * e, 0, 18 * sizeof *w->ratio_ref_u);
     }
     w->n_nodes = n_nodes;
     w->n_elems = n_elems;
@@ -871,6 +958,8 @@ int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg)
     memset(w, 0, sizeof *w);
     w->mesh = mesh;
     w->cfg = *cfg;
+    if (cfg->solver.relax == FS_RELAX_AUTO) /* see fs_solver_params and thesis §5.8 */
+        w->cfg.solver.relax = cfg->fracture.method == FS_FRACTURE_SPLIT ? FS_RELAX_LOCAL : FS_RELAX_GLOBAL;
     fs_domain_normalize(&w->mesh->domain);
     const fs_domain *d = &mesh->domain;
     w->flat = d->type != FS_DOMAIN_SPHERE;
@@ -939,6 +1028,9 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->ratio);
     free(w->stress_top);
     free(w->gauss_cache);
+    free(w->ratio_lipschitz);
+    free(w->ratio_ref_bound);
+    free(w->ratio_ref_u);
     free(w->dof);
     free(w->fixed_node_dof);
     free(w->node_elem_start);
@@ -951,6 +1043,8 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->u_fixed);
     free(w->mark);
     fs_cholesky_free(w->chol);
+    free(w->tip_node);
+    free(w->tip_dir);
     memset(w, 0, sizeof *w);
 }
 
@@ -1152,6 +1246,10 @@ int fs_wedge_remove(fs_wedge_model *w, int32_t e)
     }
     w->fractures++;
     w->counters.removals++;
+    if (w->cfg.solver.relax == FS_RELAX_LOCAL) {
+        w->factor_stale |= w->chol != NULL;
+        return 0;
+    }
     return update_factor_after_removal(w, K, g, orphans, n_orphans);
 }
 
@@ -1364,4 +1462,96 @@ int fs_wedge_subdivide(fs_wedge_model *w, const int32_t *elems, int32_t n, bool 
 int fs_wedge_refactor(fs_wedge_model *w)
 {
     return factorize(w, false);
+}
+
+int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
+{
+    double t0 = fs_seconds();
+    int32_t n_free_old = w->n_free, n_fixed_old = w->n_fixed, n0 = c->n_nodes_before, e0 = c->n_tris_before;
+    grow_arrays(w, w->mesh->n_nodes, w->mesh->n_tris);
+    for (int32_t i = n0; i < w->n_nodes; i++) {
+        int32_t a = c->node_parent[2 * (i - n0)], b = c->node_parent[2 * (i - n0) + 1];
+        double s = c->node_weight[i - n0];
+        w->thickness_factor[i] = (1.0 - s) * w->thickness_factor[a] + s * w->thickness_factor[b];
+        w->pinned[i] = w->pinned[a];
+        for (int l = 0; l < 6; l++) {
+            w->u[6 * (size_t)i + l] = (1.0 - s) * w->u[6 * (size_t)a + l] + s * w->u[6 * (size_t)b + l];
+            w->prescribed[6 * (size_t)i + l] =
+                (1.0 - s) * w->prescribed[6 * (size_t)a + l] + s * w->prescribed[6 * (size_t)b + l];
+        }
+    }
+    for (int32_t e = e0; e < w->n_elems; e++) {
+        int32_t parent = c->tri_parent[e - e0];
+        w->state[e] = w->state[parent];
+        w->young[e] = w->young[parent];
+        w->threshold[e] = w->threshold[parent];
+    }
+    number_dofs(w);
+    build_node_elems(w);
+    int32_t n_changed = c->n_changed + (w->n_elems - e0);
+    int32_t *changed = fs_malloc(((size_t)n_changed + 1) * sizeof *changed);
+    memcpy(changed, c->changed, (size_t)c->n_changed * sizeof *changed);
+    for (int32_t e = e0; e < w->n_elems; e++)
+        changed[c->n_changed + (e - e0)] = e;
+    /* the nodes whose couplings are rebuilt: those of the changed elements, and every node that lost
+     * an element to a copy (a parent of a new node) */
+    int32_t n_new = w->n_nodes - n0;
+    int32_t *nodes = fs_malloc((3 * (size_t)n_changed + 2 * (size_t)n_new + 1) * sizeof *nodes);
+    int32_t nn = 0;
+    for (int32_t q = 0; q < n_changed; q++)
+        for (int k = 0; k < 3; k++)
+            nodes[nn++] = w->mesh->tri[3 * (size_t)changed[q] + k];
+    for (int32_t q = 0; q < 2 * n_new; q++)
+        nodes[nn++] = c->node_parent[q];
+    int rc = extend_system(w, n_free_old, n_fixed_old, changed, n_changed);
+    if (rc == 0)
+        rc = update_region(w, nodes, nn);
+    if (rc == 0)
+        rc = refresh_cache(w, changed, n_changed);
+    for (int32_t i = 0; i < w->n_nodes && rc == 0; i++)
+        for (int l = 3; l < 6; l++) {
+            int32_t g = w->dof[6 * (size_t)i + l];
+            if (g < w->n_free)
+                w->x[g] = w->u[6 * (size_t)i + l];
+        }
+    free(changed);
+    free(nodes);
+    w->counters.assemble_seconds += fs_seconds() - t0;
+    if (rc < 0)
+        return -1;
+    if (w->cfg.solver.relax == FS_RELAX_LOCAL && w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
+        /* local relaxation needs no factor: the next global solve analyses and factorizes afresh */
+        fs_cholesky_free(w->chol);
+        w->chol = NULL;
+        w->factor_stale = true;
+        return 0;
+    }
+    return factorize(w, true);
+}
+
+double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e)
+{
+    if (w->state[e] != FS_WEDGE_ALIVE)
+        return 0.0;
+    double K[324], loads[FS_WEDGE_PATTERNS][18], x[18], pat[FS_WEDGE_PATTERNS][18], ue[18];
+    if (element_system(w, e, w->assembled_thickness, K, loads) < 0) {
+        fs_error_clear();
+        return NAN;
+    }
+    fs_wedge_element_coords(w, e, x);
+    patterns(x, pat);
+    gather_u(w, e, ue);
+    double coef[FS_WEDGE_PATTERNS] = {w->shrink_coef[0], w->shrink_coef[1], w->shrink_coef[2],
+                                      w->eigenstrain[0], w->eigenstrain[1], w->eigenstrain[2]};
+    for (int a = 0; a < 18; a++)
+        for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
+            ue[a] -= coef[q] * pat[q][a];
+    double energy = 0.0;
+    for (int a = 0; a < 18; a++) {
+        double f = 0.0;
+        for (int b = 0; b < 18; b++)
+            f += K[18 * a + b] * ue[b];
+        energy += f * ue[a];
+    }
+    return 0.5 * energy;
 }

@@ -65,6 +65,11 @@ typedef struct {
     int64_t subdivisions;     /* elements subdivided instead of removed (Algorithm 8) */
     double assemble_seconds, analyze_seconds, factor_seconds, update_seconds, solve_seconds,
         stress_seconds;
+    int64_t local_relaxations; /* fs_wedge_relax calls that ended in equilibrium without a global solve */
+    int64_t global_fallbacks;  /* fs_wedge_relax calls that needed a global solve */
+    int64_t relax_retries;     /* local relaxations repeated at a doubled radius within one call */
+    int64_t local_dofs;        /* unknowns of the local systems, summed over fs_wedge_relax calls */
+    double local_seconds;      /* time in fs_wedge_relax, global fallbacks included */
 } fs_wedge_counters;
 
 /* The whole state of one layer. Arrays are flat and indexed by mesh node or mesh triangle (one wedge
@@ -102,8 +107,18 @@ typedef struct {
                                     upper bound of it; exact for the largest ratio and every ratio that
                                     ties with it when that is over 1 (what fracture decides on, see
                                     wedge.c); NaN when not alive. fs_wedge_element_ratio is exact. */
-    double *stress_top;          /* 18 per element: Voigt stress (MPa) at the top Gauss points 0..2 */
+    double *stress_top;          /* 18 per element: Voigt stress (MPa) at the top Gauss points 0..2;
+                                    with lazy_ratios, as of the element's last full evaluation */
     double *gauss_cache;         /* 108 per element: geometry terms of the stress check (wedge.c) */
+    bool lazy_ratios;            /* re-evaluate at the same time only the elements whose ratio bound
+                                    could have reached 1 (wedge.c, element_ratios); set by
+                                    fs_wedge_run for element removal, off by default */
+    double *ratio_lipschitz;     /* per element: bound of the change of its ratio per cm of change of
+                                    its 18 nodal displacements (Euclidean norm) */
+    double *ratio_ref_bound;     /* per element: its ratio bound at the last full evaluation (NaN:
+                                    none valid) */
+    double *ratio_ref_u;         /* 18 per element: its nodal displacements at that evaluation */
+    double ratio_ref_coef[FS_WEDGE_PATTERNS]; /* shrinkage and eigenstrain of those evaluations */
 
     /* Global system: DOFs numbered free first (0 .. n_free - 1), then fixed. */
     int32_t n_free, n_fixed;
@@ -121,9 +136,21 @@ typedef struct {
     double assembled_thickness;  /* base thickness (cm) the system was assembled with */
     fs_cholesky *chol;           /* the factor of k_free (CHOLMOD), NULL with CG */
     int32_t updowns_pending;     /* rank updates applied since the last numeric factorization */
+    bool factor_stale;           /* k_free changed since chol was computed (local relaxation defers
+                                    the update); the next global solve re-factorizes first */
+    double relax_unit;           /* mean edge length (cm) of the living elements at the first
+                                    fs_wedge_relax call: the unit of cfg.solver.relax_radius and the
+                                    smallest radius (one ring); 0 before that call */
+    double relax_radius;         /* local relaxation radius (cm), adapted by fs_wedge_relax */
 
-    int64_t fractures;           /* elements removed so far */
+    int64_t fractures;           /* elements removed so far, or node splits (fracture.method = split) */
     fs_wedge_counters counters;
+
+    /* Element splitting (wedge_split.c, thesis §5.7.3): the crack tips that may still extend. */
+    int32_t n_tips, cap_tips;
+    int32_t *tip_node;           /* mesh node of each tip */
+    double *tip_dir;             /* 3 per tip: unit direction the crack arrived in (model frame) */
+    int64_t griffith_stops;      /* tips retired by the Griffith criterion */
 } fs_wedge_model;
 
 /* Builds the model on mesh (borrowed, kept by pointer; its edges and rings must be built, as
@@ -193,6 +220,45 @@ int fs_wedge_remove(fs_wedge_model *w, int32_t e);
  * Returns 0 or -1 with fs_error. */
 int fs_wedge_subdivide(fs_wedge_model *w, const int32_t *elems, int32_t n, bool to_min_size, int32_t *bisected);
 
+/* A change of the mesh made by the caller in place (element splitting): nodes appended from
+ * n_nodes_before on, each interpolated between node_parent[2k] and node_parent[2k + 1] with weight
+ * node_weight[k] on the second (0 for a copy of the first: a duplicated node); triangles appended
+ * from n_tris_before on, each inheriting the state and materials of tri_parent[k]; and the
+ * pre-existing triangles listed (ascending, no duplicates) in changed, whose corners or geometry
+ * changed. The mesh's adjacency and rings must already describe the changed mesh. */
+typedef struct {
+    int32_t n_nodes_before, n_tris_before;
+    const int32_t *node_parent;  /* 2 per new node */
+    const double *node_weight;   /* 1 per new node */
+    const int32_t *tri_parent;   /* 1 per new triangle */
+    const int32_t *changed;
+    int32_t n_changed;
+} fs_wedge_change;
+
+/* Brings the model up to a mesh change (see fs_wedge_change): extends the node and element arrays
+ * (new nodes get the interpolated thickness factor, displacement, prescribed values and pin flag of
+ * their parents, so w->u is a starting guess everywhere), updates the global system for the changed
+ * and new elements only, re-analyses and re-factorizes (with solver.relax = local the factor is
+ * dropped instead and w->factor_stale set: the next global solve analyses and factorizes). Does not
+ * re-solve. Returns 0 or -1. */
+int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c);
+
+/* Elastic strain energy (MPa cm^3 = J) of living element e at the current equilibrium: half the dot
+ * product of its nodal forces and displacements net of the shrinkage reference shape and growth
+ * eigenstrain (thesis Algorithm 11). 0 for a removed element; NaN if the element degenerates. */
+double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e);
+
+/* One fracture event by element splitting at the current time (thesis §5.7, Algorithms 10-12; see
+ * wedge_split.c): the crack tip with the largest nodal ratio over 1 extends, or if no tip is over its
+ * threshold, a new crack starts at the node with the largest ratio over 1. Does not re-solve unless
+ * Griffith needs the new equilibrium. *changed is 1 if the mesh changed, 0 if a tip was only retired.
+ * Returns 0, 1 if no candidate is over its threshold (nothing done), or -1 with fs_error. */
+int fs_wedge_split_event(fs_wedge_model *w, int *changed);
+
+/* The largest nodal ratio among the split candidates at the current equilibrium (tips, and nodes off
+ * every crack and boundary), -inf if none: what the split method's event search looks at. */
+double fs_wedge_split_max_ratio(const fs_wedge_model *w);
+
 /* Re-factorizes the current matrix now (CHOLMOD; nothing with CG), dropping accumulated updates.
  * Returns 0 or -1 with fs_error. */
 int fs_wedge_refactor(fs_wedge_model *w);
@@ -203,9 +269,53 @@ int fs_wedge_refactor(fs_wedge_model *w);
  * or -1 with fs_error. */
 int fs_wedge_simulate(fs_wedge_model *w, double t_end);
 
+/* design: thesis §5.8, adaptive local relaxation. After a local change of the model (an element
+ * removed, split or its nodes duplicated, a node moved) only the nodes near the change move much.
+ * The residual f - K u of the current displacements marks the free nodes out of balance (plus the
+ * changed nodes given); the marked set grows to every node within the relaxation radius, measured as
+ * the shortest path along the top edges of living elements, so cracks (removed elements, duplicated
+ * nodes) are barriers; the marked unknowns are solved with all others held (conjugate gradients on
+ * the principal submatrix). If the residual then meets the tolerance, the radius shrinks for the next
+ * event (x 0.75, not below one mean edge length); else the attempt is repeated at twice the radius,
+ * and past a quarter of the unknowns a global solve follows (the radius doubles for the next event,
+ * up to the size of the mesh). Stresses and ratios are recomputed only for elements touching a node that
+ * moved (all of them after a global solve).
+ *
+ * Tolerance: a node is out of balance, and the result acceptable, by the largest residual entry
+ * against cfg.solver.relax_tolerance times the root mean square of f over the free DOFs (f the
+ * right-hand side net of the fixed DOFs' motion). A per-entry bound, unlike a Euclidean one, does not
+ * add up the small residuals every accepted event leaves on the rim of its region, so it does not
+ * depend on the number of earlier events or on the size of the mesh.
+ *
+ * Contract: called at the current time w->time after the change, with k_all and the loads describing
+ * the changed mesh (w->factor_stale set if the factor no longer matches k_free), w->u holding a
+ * starting guess for every free DOF (fixed ones are set from their prescribed motion, see
+ * fs_wedge_prescribe_fixed), w->x, w->u_fixed and w->rhs sized for the current numbering, node_elem
+ * current, and the element caches (gauss_cache) valid.
+ * changed_nodes (n mesh nodes, may be NULL with n = 0) are relaxed whatever their residual. Fills
+ * w->u, w->x, w->rhs, w->stress_top and w->ratio like fs_wedge_equilibrium. Returns 0, or -1 with
+ * fs_error (FS_ERR_INTERNAL when the global solve fails). */
+int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n);
+
+/* The nodes fs_wedge_relax relaxes around the seed nodes (n mesh nodes) at the given radius (cm): every
+ * node joined to a seed by a path along the top edges of living elements no longer than radius, the
+ * seeds first (each once). out has room for w->n_nodes entries; returns the count. */
+int32_t fs_wedge_relax_region(const fs_wedge_model *w, const int32_t *seeds, int32_t n, double radius, int32_t *out);
+
+/* Sets the fixed DOFs (bottom nodes, pinned tops) of w->u and w->u_fixed to their prescribed
+ * displacement at w->time (growth motion included). */
+void fs_wedge_prescribe_fixed(fs_wedge_model *w);
+
+/* Recomputes stress_top and the ratios of the listed elements (all when elems is NULL, n ignored)
+ * from w->u, then makes exact every ratio fracture decides on (see the ratio field). Returns 0 or -1
+ * with fs_error. */
+int fs_wedge_update_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n);
+
 /* The render mesh of the current state (SPEC §6, texture space, see render.h): the top surface of the
  * living elements (height = top of the layer in cm, crack 0, cell = connected fragment + 1 (wrapping
  * past 65535), shade per fragment) and the floor of removed elements (height 0, crack 1, cell 0).
+ * With fracture by splitting, a floor under every element and the top surface at the in-plane
+ * displaced top-node positions, so the cracks open (wedge_render.c).
  * Fragments are the connected components of living elements sharing a node. Returns 0 or -1. */
 int fs_wedge_render_mesh(const fs_wedge_model *w, fs_render_mesh *out);
 

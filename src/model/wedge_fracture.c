@@ -71,12 +71,18 @@ int fs_wedge_fracture(fs_wedge_model *w, int *removed)
     return 0;
 }
 
+/* The largest ratio the fracture method decides on: elements (removal) or split candidates. */
+static double max_ratio(const fs_wedge_model *w)
+{
+    return w->cfg.fracture.method == FS_FRACTURE_SPLIT ? fs_wedge_split_max_ratio(w) : fs_wedge_max_ratio(w);
+}
+
 static double event_ratio(void *ctx, double t)
 {
     fs_wedge_model *w = ctx;
     if (fs_wedge_equilibrium(w, t) < 0)
         return NAN;
-    return fs_wedge_max_ratio(w);
+    return max_ratio(w);
 }
 
 static void report(const fs_wedge_model *w, double t_end)
@@ -87,7 +93,10 @@ static void report(const fs_wedge_model *w, double t_end)
 
 /* design: thesis Algorithm 1 with Algorithms 5 and 8. At the current time the model is relaxed; while
  * some element is over its threshold, one fracture event happens (removal or subdivision) and the
- * model relaxes again at the same time, so cracks run as far as the stresses drive them. When nothing
+ * model relaxes again at the same time, so cracks run as far as the stresses drive them (after a
+ * removal or a split, with solver.relax = local, by adaptive local relaxation, §5.8: fs_wedge_relax
+ * finds the nodes the change unbalanced from the residual). With fracture.method = split the event
+ * is fs_wedge_split_event and the ratio the nodal one of the split candidates. When nothing
  * is over its threshold, fs_event_find advances to just past the next time something is (within
  * time.min_step), starting with a step of half the time since the previous event. */
 int fs_wedge_simulate(fs_wedge_model *w, double t_end)
@@ -97,14 +106,21 @@ int fs_wedge_simulate(fs_wedge_model *w, double t_end)
         return -1;
     double last_event = w->time, dt_trial = fmax(min_step, (t_end - w->time) / 32.0);
     for (;;) {
-        while (fs_wedge_max_ratio(w) > 1.0) {
-            int removed;
-            int rc = fs_wedge_fracture(w, &removed);
+        while (max_ratio(w) > 1.0) {
+            int removed = 0, changed = 1, tips = w->n_tips;
+            bool split = w->cfg.fracture.method == FS_FRACTURE_SPLIT;
+            int rc = split ? fs_wedge_split_event(w, &changed) : fs_wedge_fracture(w, &removed);
             if (rc < 0)
                 return -1;
             if (rc == 1)
                 break;
-            if (fs_wedge_equilibrium(w, w->time) < 0)
+            if (!changed) {
+                if (w->n_tips == tips)
+                    break; /* nothing could be cut: let time advance */
+                continue;  /* a tip was retired: the next candidate */
+            }
+            bool local = (removed || split) && w->cfg.solver.relax == FS_RELAX_LOCAL;
+            if ((local ? fs_wedge_relax(w, NULL, 0) : fs_wedge_equilibrium(w, w->time)) < 0)
                 return -1;
             report(w, t_end);
         }
@@ -126,14 +142,10 @@ int fs_wedge_simulate(fs_wedge_model *w, double t_end)
 
 int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, fs_stats *stats)
 {
-    if (cfg->fracture.method != FS_FRACTURE_REMOVE) {
-        fs_error(FS_ERR_DATA, "[fracture] method: the wedge model fractures by element removal; expected remove, "
-                 "got split");
-        return -1;
-    }
     fs_wedge_model w;
     if (fs_wedge_init(&w, mesh, cfg) < 0)
         return -1;
+    w.lazy_ratios = cfg->fracture.method == FS_FRACTURE_REMOVE;
     int rc = fs_wedge_simulate(&w, cfg->time.end);
     if (rc == 0)
         rc = fs_wedge_render_mesh(&w, surface);
@@ -141,6 +153,9 @@ int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, f
         const fs_wedge_counters *c = &w.counters;
         stats->fractures = w.fractures;
         stats->simulated_time = w.time;
+        fs_debug("wedge: %lld splits, %lld tips retired by Griffith, %d tips left; relaxations %lld local, "
+                 "%lld global", (long long)w.fractures, (long long)w.griffith_stops, (int)w.n_tips,
+                 (long long)w.counters.local_relaxations, (long long)w.counters.global_fallbacks);
         fs_debug("wedge: %lld removals, %lld subdivisions, %lld solves (%.2f s), %lld factorizations (%.2f s), "
                  "%lld analyses (%.2f s), %lld updates (%.2f s), assembly %.2f s, stresses %.2f s, "
                  "%lld CG iterations",

@@ -250,6 +250,19 @@ static double top_height(const fs_wedge_model *w, int32_t node)
     return w->assembled_thickness * w->thickness_factor[node] + rise;
 }
 
+/* In-plane displacement of a node's top (cm, model frame): what opens the cracks of the split method. */
+static void top_shift(const fs_wedge_model *w, int32_t node, double *p)
+{
+    const double *u = w->u + 6 * (size_t)node + 3, *n = w->normal + 3 * (size_t)node;
+    double un = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
+    for (int k = 0; k < 3; k++)
+        p[k] += u[k] - un * n[k];
+}
+
+/* design: with fracture by splitting (wedge_split.c) every element stays alive and a crack is a pair
+ * of walls on duplicated nodes at the same rest position, so the render draws a floor of every
+ * element at height 0 marked crack, and over it the top surface at the displaced top-node positions:
+ * the in-plane displacement opens the cracks (the highest surface wins, render.h). */
 int fs_wedge_render_mesh(const fs_wedge_model *w, fs_render_mesh *out)
 {
     memset(out, 0, sizeof *out);
@@ -259,13 +272,17 @@ int fs_wedge_render_mesh(const fs_wedge_model *w, fs_render_mesh *out)
     const fs_domain *d = &m->domain;
     double ext[2] = {fs_domain_extent_x(d), fs_domain_extent_y(d)};
     sphere_ctx sc = {d, out};
+    bool split = w->cfg.fracture.method == FS_FRACTURE_SPLIT;
+    for (int pass = split ? 0 : 1; pass < 2; pass++)
     for (int32_t e = 0; e < w->n_elems; e++) {
         attr a[3];
         double p[3][3];
         for (int c = 0; c < 3; c++) {
             int32_t node = m->tri[3 * (size_t)e + c];
             fs_mesh_corner(m, e, c, p[c]);
-            if (label[e] < 0) {
+            if (pass == 1 && split && label[e] >= 0)
+                top_shift(w, node, p[c]);
+            if (pass == 0 || label[e] < 0) {
                 a[c] = (attr){0.0, 1.0, 0.0, 0.0};
             } else {
                 double shade = 2.0 * fs_rand01(w->cfg.preset.seed, FS_RNG_CELL_COLOR, (uint64_t)label[e]) - 1.0;

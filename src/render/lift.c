@@ -828,6 +828,196 @@ static int32_t split_columns(lift_ctx *c)
     return splits;
 }
 
+/* Union-find root with path halving. */
+static int32_t uf_find(int32_t *parent, int32_t i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+static void uf_union(int32_t *parent, int32_t a, int32_t b)
+{
+    a = uf_find(parent, a);
+    b = uf_find(parent, b);
+    if (a != b)
+        parent[a < b ? b : a] = a < b ? a : b;
+}
+
+/* The corner of triangle f at position v (FS_ASSERT: there is one). */
+static int corner_at(const tri *f, int32_t v)
+{
+    for (int k = 0; k < 3; k++)
+        if (f->pos[k] == v)
+            return k;
+    FS_ASSERT(!"corner_at: the triangle has no such position");
+    return 0;
+}
+
+/* One triangle around a non-manifold edge: its angle about the edge and which way it faces. */
+typedef struct {
+    double angle;
+    int32_t face;
+    int8_t front_ccw; /* its front side is the counter-clockwise side about the edge */
+} fan_entry;
+
+static int cmp_fan(const void *x, const void *y)
+{
+    const fan_entry *a = x, *b = y;
+    if (a->angle != b->angle)
+        return a->angle < b->angle ? -1 : 1;
+    return a->face < b->face ? -1 : (a->face > b->face);
+}
+
+/* design: where two fragments touch only along a line or at a point (wedge elements alive on one
+ * diagonal of a node and removed on the other; a springs cell corner touching its neighbour's), the
+ * welded surface has edges of four triangles and vertices whose triangles form several fans. Such a
+ * mesh is not a manifold, and OBJ readers, normal smoothing and booleans get it wrong. So the
+ * triangles around an edge of more than two are sorted by angle about it and each is paired with its
+ * neighbour on its back side (the material side: a fragment's two walls at its corner go together,
+ * not a wall of each fragment across the air between them); a pair, like the two triangles of an
+ * ordinary edge, joins its triangles' corners at the edge's ends. Each position then keeps one
+ * copy per group of joined corners around it, the first group the original index, so every edge has
+ * at most two triangles and every fragment's surface is a manifold of its own, meeting the others
+ * at coinciding positions. An edge whose triangles do not pair up (an odd number, or neighbours that
+ * do not face each other) is left as it is. Returns the number of positions added. */
+static int32_t split_nonmanifold(lift_ctx *c)
+{
+    edge_table et;
+    edges_build(&et, c->t, c->n_t);
+    int32_t n_corner = 3 * c->n_t;
+    int32_t *parent = fs_malloc(((size_t)n_corner + 1) * sizeof *parent);
+    for (int32_t i = 0; i < n_corner; i++)
+        parent[i] = i;
+    /* faces of the edges of more than two, as lists */
+    int32_t *start = fs_calloc((size_t)et.n + 2, sizeof *start);
+    int32_t n_bad = 0;
+    for (int32_t f = 0; f < c->n_t; f++)
+        for (int k = 0; k < 3; k++) {
+            int32_t r = et.face_edge[3 * f + k];
+            if (et.e[r].count > 2)
+                start[r + 1]++;
+        }
+    for (int32_t r = 0; r < et.n; r++) {
+        n_bad += et.e[r].count > 2;
+        start[r + 1] += start[r];
+    }
+    int32_t *fill = fs_malloc(((size_t)et.n + 1) * sizeof *fill);
+    memcpy(fill, start, (size_t)et.n * sizeof *fill);
+    int32_t *faces = fs_malloc(((size_t)start[et.n] + 1) * sizeof *faces);
+    for (int32_t f = 0; f < c->n_t; f++)
+        for (int k = 0; k < 3; k++) {
+            int32_t r = et.face_edge[3 * f + k];
+            if (et.e[r].count > 2)
+                faces[fill[r]++] = f;
+        }
+    free(fill);
+    fan_entry *fan = NULL;
+    int32_t cap_fan = 0, unpaired = 0;
+    for (int32_t r = 0; r < et.n; r++) {
+        const edge_rec *er = et.e + r;
+        if (er->count == 2) {
+            for (int q = 0; q < 2; q++) {
+                int32_t v = q ? er->b : er->a;
+                uf_union(parent, 3 * er->face[0] + corner_at(c->t + er->face[0], v),
+                         3 * er->face[1] + corner_at(c->t + er->face[1], v));
+            }
+            continue;
+        }
+        if (er->count < 3)
+            continue;
+        int32_t m = start[r + 1] - start[r];
+        if (m > cap_fan) {
+            cap_fan = m;
+            fan = fs_realloc(fan, (size_t)cap_fan * sizeof *fan);
+        }
+        const double *pa = c->pos.p + 3 * (size_t)er->a, *pb = c->pos.p + 3 * (size_t)er->b;
+        double axis[3], u[3], w[3];
+        fs_sub3(axis, pb, pa);
+        double len = fs_norm3(axis);
+        for (int q = 0; q < 3; q++)
+            axis[q] /= len;
+        /* a unit vector across the axis, then the third of a right-handed frame */
+        double pick[3] = {0.0, 0.0, 0.0};
+        int least = fabs(axis[0]) <= fabs(axis[1]) && fabs(axis[0]) <= fabs(axis[2]) ? 0
+                    : (fabs(axis[1]) <= fabs(axis[2]) ? 1 : 2);
+        pick[least] = 1.0;
+        fs_cross3(u, axis, pick);
+        double len_u = fs_norm3(u);
+        for (int q = 0; q < 3; q++)
+            u[q] /= len_u;
+        fs_cross3(w, axis, u);
+        for (int32_t i = 0; i < m; i++) {
+            int32_t f = faces[start[r] + i];
+            const tri *t = c->t + f;
+            int32_t x = t->pos[0] != er->a && t->pos[0] != er->b ? t->pos[0]
+                        : (t->pos[1] != er->a && t->pos[1] != er->b ? t->pos[1] : t->pos[2]);
+            double d[3], n[3], e1[3], e2[3], turn[3];
+            fs_sub3(d, c->pos.p + 3 * (size_t)x, pa);
+            fs_sub3(e1, c->pos.p + 3 * (size_t)t->pos[1], c->pos.p + 3 * (size_t)t->pos[0]);
+            fs_sub3(e2, c->pos.p + 3 * (size_t)t->pos[2], c->pos.p + 3 * (size_t)t->pos[0]);
+            fs_cross3(n, e1, e2);
+            fs_cross3(turn, axis, d); /* the counter-clockwise direction about the axis at d */
+            fan[i] = (fan_entry){atan2(fs_dot3(d, w), fs_dot3(d, u)), f, (int8_t)(fs_dot3(n, turn) > 0.0)};
+        }
+        qsort(fan, (size_t)m, sizeof *fan, cmp_fan);
+        /* the back side of a triangle facing counter-clockwise is its clockwise neighbour */
+        bool ok = m % 2 == 0;
+        for (int32_t i = 0; ok && i < m; i++) {
+            int32_t j = fan[i].front_ccw ? (i + m - 1) % m : (i + 1) % m;
+            int32_t back = fan[j].front_ccw ? (j + m - 1) % m : (j + 1) % m;
+            ok = back == i && fan[i].front_ccw != fan[j].front_ccw;
+        }
+        for (int32_t i = 0; i < m; i++) {
+            int32_t j = ok ? (fan[i].front_ccw ? (i + m - 1) % m : (i + 1) % m) : 0;
+            for (int q = 0; q < 2; q++) {
+                int32_t v = q ? er->b : er->a;
+                uf_union(parent, 3 * fan[i].face + corner_at(c->t + fan[i].face, v),
+                         3 * fan[j].face + corner_at(c->t + fan[j].face, v));
+            }
+        }
+        unpaired += !ok;
+    }
+    free(fan);
+    free(faces);
+    free(start);
+    edges_free(&et);
+
+    /* one copy of each position per group of joined corners; the group met first keeps it */
+    int32_t *group_pos = fs_malloc(((size_t)n_corner + 1) * sizeof *group_pos); /* per root: its position */
+    int32_t *owner = fs_malloc(((size_t)c->pos.n + 1) * sizeof *owner);         /* per position: its first root */
+    for (int32_t i = 0; i < c->pos.n; i++)
+        owner[i] = -1;
+    int32_t added = 0;
+    for (int32_t i = 0; i < n_corner; i++) {
+        int32_t v = c->t[i / 3].pos[i % 3], root = uf_find(parent, i);
+        if (root == i) {
+            if (owner[v] < 0) {
+                owner[v] = root;
+                group_pos[root] = v;
+            } else {
+                if (c->pos.n == c->pos.cap) {
+                    c->pos.cap = 2 * c->pos.cap;
+                    c->pos.p = fs_realloc(c->pos.p, 3 * (size_t)c->pos.cap * sizeof *c->pos.p);
+                }
+                memcpy(c->pos.p + 3 * (size_t)c->pos.n, c->pos.p + 3 * (size_t)v, 3 * sizeof *c->pos.p);
+                group_pos[root] = c->pos.n++;
+                added++;
+            }
+        }
+        c->t[i / 3].pos[i % 3] = group_pos[root];
+    }
+    if (n_bad > 0 || added > 0)
+        fs_debug("lift: %d edges of more than two triangles (%d not paired), %d positions added", (int)n_bad,
+                 (int)unpaired, (int)added);
+    free(group_pos);
+    free(owner);
+    free(parent);
+    return added;
+}
+
 /* Unit normal and the corner angles of triangle f; the normal is zero for a degenerate triangle. */
 static void face_geometry(const lift_ctx *c, const tri *f, double *n, double *angle)
 {
@@ -984,6 +1174,7 @@ int fs_render_mesh_lift(const fs_render_mesh *m, const fs_domain *dom, double he
     close_steps(&c);
     for (int pass = 0; pass < 4 && split_columns(&c) > 0; pass++)
         continue;
+    split_nonmanifold(&c);
 
     out->weld_tolerance = tol;
     out->n_uv = c.uv.n;

@@ -102,7 +102,8 @@ void fs_maps_free(fs_maps *m);
  * poles) is one vertex with several texture coordinates. */
 typedef struct {
     int32_t n_pos;
-    double *pos;         /* 3 per position, world cm; no two closer than weld_tolerance */
+    double *pos;         /* 3 per position, world cm; no two closer than weld_tolerance unless equal:
+                          * equal ones are copies where fragments touch (see fs_render_mesh_lift) */
     int32_t n_uv;
     float *uv;           /* 2 per texture vertex, in [0, 1]; v is the maps' v (up the image) */
     int32_t n_normal;
@@ -126,7 +127,9 @@ typedef struct {
  * texture space; the lift closes every such step by a vertical wall of two triangles (and cuts the
  * walls' upright edges where walls of different heights meet), so the result is bounded only along
  * the domain's borders: the four sides of a plane (periodic or not: a tile is a flat slab in 3-D),
- * the two ends of a cylinder, nowhere on a sphere. Corner normals average, weighted by angle, the
+ * the two ends of a cylinder, nowhere on a sphere. Where fragments touch only at a corner or along a
+ * line (edges of four triangles), positions are copied so that each fragment's surface is a manifold
+ * of its own (see split_nonmanifold in lift.c). Corner normals average, weighted by angle, the
  * normals of the triangles around the position within 50 degrees of the corner's own triangle, so
  * walls and tops keep a crisp edge. Returns 0, or -1 with fs_error(FS_ERR_INTERNAL) for a
  * non-finite vertex. */

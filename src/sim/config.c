@@ -38,6 +38,9 @@ fs_config fs_config_default(void)
     c.solver.method = FS_SOLVER_CHOLMOD;
     c.solver.tolerance = 1e-8;
     c.solver.max_iterations = 0;
+    c.solver.relax = FS_RELAX_AUTO;
+    c.solver.relax_radius = 4.0;
+    c.solver.relax_tolerance = 1e-4;
 
     c.wedge.thickness_gradient = 0.0;
     return c;

@@ -41,6 +41,7 @@ typedef struct {
 } fs_time_params;
 
 typedef enum { FS_SOLVER_CHOLMOD = 0, FS_SOLVER_CG } fs_solver_method;
+typedef enum { FS_RELAX_AUTO = 0, FS_RELAX_GLOBAL, FS_RELAX_LOCAL } fs_relax_mode;
 
 /* How the finite element models solve for equilibrium: sparse Cholesky (factored once, updated after
  * fractures) or the thesis' conjugate gradients, kept as a baseline. */
@@ -48,6 +49,12 @@ typedef struct {
     fs_solver_method method;
     double tolerance;       /* cg: relative residual ||b - Ax|| / ||b|| to stop at */
     int32_t max_iterations; /* cg: iteration limit, 0 for the number of unknowns */
+    fs_relax_mode relax;    /* after a local change (a fracture): relax the whole model, or first
+                               only the nodes around the change (thesis §5.8); auto: local when
+                               fracturing by splitting, global by removal */
+    double relax_radius;    /* local: initial radius of the relaxed region, in mean edge lengths */
+    double relax_tolerance; /* local: a local relaxation is accepted when no residual entry of
+                               f - K u exceeds relax_tolerance times the root mean square of f */
 } fs_solver_params;
 
 /* Wedge model settings that have no section of their own. */

@@ -1,6 +1,7 @@
 /* The run of one configuration: sample the domain, mesh it, run the model, hand back a render mesh. */
 #include "sim/sim.h"
 
+#include <stdbool.h>
 #include <string.h>
 
 #include "base/error.h"
@@ -26,9 +27,92 @@ static int sample_points(const fs_config *cfg, fs_points *pts)
     return fs_sample_repulsion(&cfg->domain, &sp, pts);
 }
 
+/* Time of frame k of count over [0, end]; the last one is exactly end. */
+static double frame_time(const fs_config *cfg, int32_t k, int32_t count)
+{
+    return k == count ? cfg->time.end : cfg->time.end * (double)k / (double)count;
+}
+
+/* The springs model in segments: init, advance to each frame time, render each frame. */
+static int run_springs_frames(const fs_config *cfg, const fs_sim_frames *frames, fs_result *out)
+{
+    fs_springs_setup setup;
+    memset(&setup, 0, sizeof setup);
+    setup.springs = cfg->springs;
+    setup.material = cfg->material;
+    setup.growth = cfg->growth;
+    setup.shrink = cfg->shrink;
+    setup.time_end = cfg->time.end;
+    setup.min_step = cfg->time.min_step;
+    setup.seed = cfg->preset.seed;
+    fs_springs s;
+    int rc = fs_springs_init(&s, &out->mesh, &setup);
+    for (int32_t k = 1; rc == 0 && k <= frames->count; k++) {
+        double t = frame_time(cfg, k, frames->count);
+        fs_progress_scale(cfg->time.end > 0.0 ? t / cfg->time.end : 1.0);
+        rc = fs_springs_advance(&s, t);
+        if (rc < 0)
+            break;
+        fs_progress("springs", -1, "frame %d of %d: 3-D post-process of %d cells", (int)k, (int)frames->count,
+                    (int)out->mesh.n_nodes);
+        fs_render_mesh frame = {0};
+        fs_render_mesh *surface = k == frames->count ? &out->surface : &frame;
+        rc = fs_springs_render(&s, surface);
+        out->stats.fractures = s.break_count;
+        out->stats.simulated_time = s.time;
+        if (rc == 0)
+            rc = frames->fn(frames->ctx, k, frames->count, t, surface, &out->stats);
+        fs_render_mesh_free(&frame);
+    }
+    fs_springs_free(&s);
+    return rc;
+}
+
+/* The wedge model in segments: init, simulate to each frame time, render each frame. */
+static int run_wedge_frames(const fs_config *cfg, const fs_sim_frames *frames, fs_result *out)
+{
+    fs_wedge_model w;
+    if (fs_wedge_init(&w, &out->mesh, cfg) < 0)
+        return -1;
+    int rc = 0;
+    for (int32_t k = 1; rc == 0 && k <= frames->count; k++) {
+        double t = frame_time(cfg, k, frames->count);
+        fs_progress_scale(cfg->time.end > 0.0 ? t / cfg->time.end : 1.0);
+        rc = fs_wedge_simulate(&w, t);
+        if (rc < 0)
+            break;
+        fs_render_mesh frame = {0};
+        fs_render_mesh *surface = k == frames->count ? &out->surface : &frame;
+        rc = fs_wedge_render_mesh(&w, surface);
+        out->stats.fractures = w.fractures;
+        out->stats.simulated_time = w.time;
+        out->stats.elements = w.n_elems;
+        if (rc == 0)
+            rc = frames->fn(frames->ctx, k, frames->count, t, surface, &out->stats);
+        fs_render_mesh_free(&frame);
+    }
+    fs_wedge_free(&w);
+    return rc;
+}
+
 int fs_sim_run(const fs_config *cfg, fs_result *out)
 {
+    return fs_sim_run_frames(cfg, NULL, out);
+}
+
+int fs_sim_run_frames(const fs_config *cfg, const fs_sim_frames *frames, fs_result *out)
+{
     memset(out, 0, sizeof *out);
+    if (frames && frames->count > 0 && cfg->preset.model == FS_MODEL_VORONOI) {
+        fs_error(FS_ERR_DATA, "time-lapse frames: the voronoi model has no time; expected a springs or wedge "
+                 "model");
+        return -1;
+    }
+    if (frames && frames->count > 0 && !frames->fn) {
+        fs_error(FS_ERR_INTERNAL, "frames requested without a frame callback");
+        return -1;
+    }
+    bool segmented = frames && frames->count > 0;
     fs_domain domain = cfg->domain;
     fs_domain_normalize(&domain);
 
@@ -54,12 +138,16 @@ int fs_sim_run(const fs_config *cfg, fs_result *out)
         rc = fs_voronoi_render_mesh(&out->mesh, &cfg->voronoi, cfg->preset.seed, &out->surface);
         break;
     case FS_MODEL_SPRINGS:
+        if (segmented) {
+            rc = run_springs_frames(cfg, frames, out);
+            break;
+        }
         rc = fs_springs_run(&out->mesh, &cfg->springs, &cfg->material, &cfg->growth, &cfg->shrink, cfg->time.end,
                             cfg->time.min_step, cfg->preset.seed, &out->surface, &out->stats.fractures,
                             &out->stats.simulated_time);
         break;
     case FS_MODEL_WEDGE:
-        rc = fs_wedge_run(cfg, &out->mesh, &out->surface, &out->stats);
+        rc = segmented ? run_wedge_frames(cfg, frames, out) : fs_wedge_run(cfg, &out->mesh, &out->surface, &out->stats);
         break;
     default:
         fs_error(FS_ERR_DATA, "[preset] model: the %s model is not available in this build; expected voronoi",
@@ -68,6 +156,7 @@ int fs_sim_run(const fs_config *cfg, fs_result *out)
         break;
     }
     double t3 = fs_seconds();
+    fs_progress_scale(1.0);
     fs_progress_done();
     if (rc < 0) {
         fs_result_free(out);

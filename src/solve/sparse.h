@@ -78,8 +78,16 @@ int32_t fs_sparse_matrix_add_block(fs_sparse_matrix *m, int32_t k, const int32_t
  * must not overlap. Deterministic (fixed summation order). */
 void fs_sparse_matvec(const fs_sparse_matrix *m, const double *x, double *y);
 
+/* The principal submatrix of a on the m unknowns idx (strictly increasing): out (which must not hold
+ * arrays) receives, in the same storage rules, the entries of a whose row and column are both listed,
+ * unknown idx[q] becoming q. map is scratch of a->n entries, all -1 on entry and again on return
+ * (callers keep one array across calls, so the cost is that of the listed columns). Release out with
+ * fs_sparse_matrix_free. */
+void fs_sparse_matrix_principal(const fs_sparse_matrix *a, const int32_t *idx, int32_t m, int32_t *map,
+                                fs_sparse_matrix *out);
+
 /* Sparse Cholesky factorization A = P' L L' P (or L D L') of a symmetric positive definite matrix through
- * CHOLMOD: a fill-reducing ordering (AMD, or METIS when AMD fills badly, as CHOLMOD picks) and a
+ * CHOLMOD: a fill-reducing ordering (the better of AMD and METIS) and a
  * supernodal or simplicial factor (CHOLMOD chooses by the flop count). Opaque; one object per thread. */
 typedef struct fs_cholesky fs_cholesky;
 

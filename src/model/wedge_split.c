@@ -1,0 +1,832 @@
+/* The wedge model's fracture by element splitting (thesis §5.7): nodal criterion, node duplication, element cutting, crack tips, edge collapse, Griffith termination. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "base/vec.h"
+#include "fracture/eigen.h"
+#include "fracture/rank.h"
+#include "fracture/split.h"
+#include "geom/refine.h"
+#include "model/wedge.h"
+
+/* design: thesis §5.7. The layer is a surface mesh extruded into wedge columns, and a crack always
+ * cuts a whole column (the top and the bottom node of a mesh node together), so splitting is a 2-D
+ * operation on the surface mesh, done in the tangent plane of the breaking node n (the unwrapped
+ * flat frame on the plane and cylinder, with the periodic corner shifts; the plane through n normal
+ * to the sphere on the sphere).
+ *
+ * Criterion (§5.7.1): the nodal stress of n's top node (the average of its elements' top Gauss point
+ * nearest n) against the mean threshold of those elements. The crack line is normal to the largest
+ * principal direction projected onto the tangent plane.
+ *
+ * Cut (Algorithms 10 and 12): a new crack sends two opposite rays from n, a tip one ray, the one that
+ * continues its crack. The ray leaves the fan of n through the far edge ab of one sector (n, a, b)
+ * (fs_split_ray_sector); the sector and its neighbour across ab are split at the crossing p, so the
+ * mesh stays conforming. When p falls within SNAP of a or b, that node is moved onto the crack line if
+ * it is free (edge collapse, Algorithm 12: interior, not on a crack, not a tip, not pinned, every
+ * element around it stays well shaped and it does not cross a periodic seam); otherwise the ray is
+ * snapped through it. Then every node on a cut whose fan the cuts disconnect (n itself, and a far end
+ * lying on a crack wall or the boundary) is duplicated: each further connected sector of its fan gets
+ * a copy, at the same position. Crack edges are thus simply boundary edges of the mesh, cracks that
+ * reach an existing crack end in a T-junction, and a far end whose fan stays connected becomes a tip.
+ * Elements are never removed: fragments separate because they no longer share nodes.
+ *
+ * Tips: averaged over the elements around a tip, the nodal stress mixes the loaded element ahead of
+ * the crack with the unloaded walls behind it and misses the stress concentration that the thesis
+ * resolves with a temporary finer mesh at the tip (§5.7.8); this model takes instead, at a tip, the
+ * largest ratio (and its direction) among the top Gauss points nearest the tip, one per element.
+ *
+ * Order (Fig. 5.20): tips first (largest ratio over 1 among tips), new cracks only when no tip is
+ * over its threshold; new cracks start only at nodes off every crack and boundary (interior nodes).
+ *
+ * Griffith (§5.7.4, Algorithm 11), for tip extensions when fracture.griffith is set: the elastic
+ * energy before (e1) and after (e2, at the new equilibrium) the extension, G = (e1 - e2) / a with a
+ * the new wall area (cut length times the local thickness). If G <= Gc (material.toughness) the
+ * crack is terminated: as in Algorithm 11 the extension that was measured stays, and its new tip is
+ * retired, so the crack cannot run further and no energy is created by undoing. The energies are
+ * summed over the elements within GRIFFITH_RINGS edge rings of n (the same material before and
+ * after: split elements keep their slot or name it as parent), not over the whole layer; the
+ * release of a short extension is concentrated there, and it keeps the check's cost independent of
+ * the layer's size, at the price of slightly underestimating G.
+ *
+ * Subdivision around tips (§5.7.6): before a node breaks, the elements of its one-ring and their
+ * neighbours that are not yet below mesh.min_size are bisected (fs_wedge_subdivide) and the event
+ * ends there; the model relaxes and the criterion is evaluated again on the finer mesh.
+ *
+ * The global system after a cut is updated in place for the changed elements (fs_wedge_apply_change)
+ * and re-factorized; duplicated and new nodes start from the displacement of the nodes they came
+ * from. */
+
+/* Fraction of an edge within which a cut snaps to (or collapses) its end node. */
+#define SNAP 0.2
+/* An edge collapse is refused if an element around the moved node would keep less than this
+ * fraction of its area. */
+#define COLLAPSE_MIN_AREA 0.25
+/* Edge rings around the breaking node whose elements the Griffith energies are summed over. */
+#define GRIFFITH_RINGS 6
+
+/* ---- frames ---- */
+
+typedef struct {
+    bool flat;
+    double e1[3], e2[3];
+} frame;
+
+static void frame_at(const fs_wedge_model *w, int32_t n, frame *f)
+{
+    f->flat = w->flat;
+    if (f->flat) {
+        f->e1[0] = 1.0, f->e1[1] = 0.0, f->e1[2] = 0.0;
+        f->e2[0] = 0.0, f->e2[1] = 1.0, f->e2[2] = 0.0;
+        return;
+    }
+    const double *nrm = w->normal + 3 * (size_t)n;
+    double axis[3] = {0.0, 0.0, 1.0};
+    if (fabs(nrm[2]) > 0.9) {
+        axis[0] = 1.0;
+        axis[2] = 0.0;
+    }
+    fs_cross3(f->e1, axis, nrm);
+    double len = fs_norm3(f->e1);
+    for (int k = 0; k < 3; k++)
+        f->e1[k] /= len;
+    fs_cross3(f->e2, nrm, f->e1);
+}
+
+static void to_2d(const frame *f, const double v[3], double out[2])
+{
+    out[0] = fs_dot3(f->e1, v);
+    out[1] = fs_dot3(f->e2, v);
+}
+
+static void from_2d(const frame *f, const double v[2], double out[3])
+{
+    for (int k = 0; k < 3; k++)
+        out[k] = v[0] * f->e1[k] + v[1] * f->e2[k];
+}
+
+/* ---- the nodal criterion ---- */
+
+/* Ratio of the top Gauss point of element e nearest corner c, and its principal direction. */
+static double point_ratio(const fs_wedge_model *w, int32_t e, int c, double m[3])
+{
+    double sigma[3], dirs[9];
+    if (fs_eigen_principal_stress(w->stress_top + 18 * (size_t)e + 6 * c, sigma, dirs) < 0) {
+        fs_error_clear();
+        return -INFINITY;
+    }
+    if (m)
+        memcpy(m, dirs, 3 * sizeof *m);
+    return sigma[0] / w->threshold[e];
+}
+
+/* Ratio at crack tip i: the largest over its elements of the ratio at the top Gauss point nearest the
+ * tip, and that point's principal direction (see the design note). */
+static double tip_ratio(const fs_wedge_model *w, int32_t i, double m[3])
+{
+    double best = -INFINITY;
+    for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++) {
+        int32_t e = w->node_elem[p];
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        int c = 0;
+        while (c < 3 && w->mesh->tri[3 * (size_t)e + c] != i)
+            c++;
+        double d[3];
+        double r = point_ratio(w, e, c, d);
+        if (r > best) {
+            best = r;
+            if (m)
+                memcpy(m, d, sizeof d);
+        }
+    }
+    return best;
+}
+
+/* Nodal ratio of node i (thesis §5.7.1), and the fracture plane normal (3-D, unit) if m is not NULL.
+ * The top Gauss point nearest corner c is top point c (wedge_element.h), whose stress the last
+ * equilibrium left in stress_top. -inf for a node without a living element. */
+static double node_ratio(const fs_wedge_model *w, int32_t i, double m[3])
+{
+    double s[6] = {0}, thr = 0.0;
+    int count = 0;
+    for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++) {
+        int32_t e = w->node_elem[p];
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        int c = 0;
+        while (c < 3 && w->mesh->tri[3 * (size_t)e + c] != i)
+            c++;
+        const double *st = w->stress_top + 18 * (size_t)e + 6 * c;
+        for (int k = 0; k < 6; k++)
+            s[k] += st[k];
+        thr += w->threshold[e];
+        count++;
+    }
+    if (count == 0)
+        return -INFINITY;
+    for (int k = 0; k < 6; k++)
+        s[k] /= count;
+    double sigma[3], dirs[9];
+    if (fs_eigen_principal_stress(s, sigma, dirs) < 0) {
+        fs_error_clear();
+        return -INFINITY;
+    }
+    if (m)
+        memcpy(m, dirs, 3 * sizeof *m);
+    return sigma[0] / (thr / count);
+}
+
+/* open[i] = 1 for a node on a boundary edge of the mesh: a crack wall, a tip or the domain's border. */
+static uint8_t *open_nodes(const fs_wedge_model *w)
+{
+    const fs_mesh *m = w->mesh;
+    uint8_t *open = fs_calloc((size_t)m->n_nodes + 1, 1);
+    for (int32_t h = 0; h < 3 * m->n_tris; h++)
+        if (m->adj[h] < 0) {
+            open[m->tri[h]] = 1;
+            open[m->tri[3 * (h / 3) + (h % 3 + 1) % 3]] = 1;
+        }
+    return open;
+}
+
+double fs_wedge_split_max_ratio(const fs_wedge_model *w)
+{
+    double best = -INFINITY;
+    for (int32_t k = 0; k < w->n_tips; k++)
+        best = fmax(best, tip_ratio(w, w->tip_node[k], NULL));
+    uint8_t *open = open_nodes(w);
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        if (!open[i])
+            best = fmax(best, node_ratio(w, i, NULL));
+    free(open);
+    return best;
+}
+
+/* ---- tips ---- */
+
+static int32_t tip_find(const fs_wedge_model *w, int32_t node)
+{
+    for (int32_t k = 0; k < w->n_tips; k++)
+        if (w->tip_node[k] == node)
+            return k;
+    return -1;
+}
+
+static void tip_remove(fs_wedge_model *w, int32_t node)
+{
+    int32_t k = tip_find(w, node);
+    if (k < 0)
+        return;
+    w->n_tips--;
+    memmove(w->tip_node + k, w->tip_node + k + 1, (size_t)(w->n_tips - k) * sizeof *w->tip_node);
+    memmove(w->tip_dir + 3 * k, w->tip_dir + 3 * (k + 1), 3 * (size_t)(w->n_tips - k) * sizeof *w->tip_dir);
+}
+
+static void tip_add(fs_wedge_model *w, int32_t node, const double dir[3])
+{
+    if (tip_find(w, node) >= 0)
+        return;
+    if (w->n_tips == w->cap_tips) {
+        w->cap_tips = w->cap_tips ? 2 * w->cap_tips : 16;
+        w->tip_node = fs_realloc(w->tip_node, (size_t)w->cap_tips * sizeof *w->tip_node);
+        w->tip_dir = fs_realloc(w->tip_dir, 3 * (size_t)w->cap_tips * sizeof *w->tip_dir);
+    }
+    w->tip_node[w->n_tips] = node;
+    memcpy(w->tip_dir + 3 * (size_t)w->n_tips, dir, 3 * sizeof *dir);
+    w->n_tips++;
+}
+
+/* ---- growing lists ---- */
+
+typedef struct {
+    int32_t *v;
+    int32_t n, cap;
+} ilist;
+
+static void ilist_push(ilist *l, int32_t x)
+{
+    if (l->n == l->cap) {
+        l->cap = l->cap ? 2 * l->cap : 16;
+        l->v = fs_realloc(l->v, (size_t)l->cap * sizeof *l->v);
+    }
+    l->v[l->n++] = x;
+}
+
+/* ---- the cut ---- */
+
+/* Bookkeeping of one cut, in the terms of fs_wedge_change. */
+typedef struct {
+    fs_wedge_model *w;
+    int32_t n_nodes0, n_tris0;
+    ilist node_parent;   /* 2 per new node */
+    double *node_weight; /* per new node */
+    ilist tri_parent;    /* per new triangle */
+    uint8_t *changed;    /* per pre-cut triangle */
+} cut_state;
+
+static void mark_changed(cut_state *cs, int32_t t)
+{
+    if (t < cs->n_tris0)
+        cs->changed[t] = 1;
+}
+
+static int32_t new_node(cut_state *cs, const double pos[3], int32_t a, int32_t b, double s)
+{
+    fs_mesh *m = cs->w->mesh;
+    double p[3] = {pos[0], pos[1], pos[2]}; /* pos may point into m->pos, which moves */
+    int32_t i = m->n_nodes++;
+    m->pos = fs_realloc(m->pos, 3 * (size_t)m->n_nodes * sizeof *m->pos);
+    memcpy(m->pos + 3 * (size_t)i, p, sizeof p);
+    ilist_push(&cs->node_parent, a);
+    ilist_push(&cs->node_parent, b);
+    int32_t k = i - cs->n_nodes0;
+    cs->node_weight = fs_realloc(cs->node_weight, ((size_t)k + 1) * sizeof *cs->node_weight);
+    cs->node_weight[k] = s;
+    return i;
+}
+
+static int32_t new_tri(cut_state *cs, int32_t parent)
+{
+    fs_mesh *m = cs->w->mesh;
+    int32_t t = m->n_tris++;
+    m->tri = fs_realloc(m->tri, 3 * (size_t)m->n_tris * sizeof *m->tri);
+    memcpy(m->tri + 3 * (size_t)t, m->tri + 3 * (size_t)parent, 3 * sizeof *m->tri);
+    if (m->shift) {
+        m->shift = fs_realloc(m->shift, 6 * (size_t)m->n_tris * sizeof *m->shift);
+        memcpy(m->shift + 6 * (size_t)t, m->shift + 6 * (size_t)parent, 6 * sizeof *m->shift);
+    }
+    ilist_push(&cs->tri_parent, parent < cs->n_tris0 ? parent : cs->tri_parent.v[parent - cs->n_tris0]);
+    return t;
+}
+
+/* Shifts of triangle t renormalised so that its first corner has shift (0, 0). */
+static void normalize_shifts(fs_mesh *m, int32_t t)
+{
+    if (!m->shift)
+        return;
+    int8_t *s = m->shift + 6 * (size_t)t;
+    int8_t s0 = s[0], s1 = s[1];
+    for (int c = 0; c < 3; c++) {
+        s[2 * c] = (int8_t)(s[2 * c] - s0);
+        s[2 * c + 1] = (int8_t)(s[2 * c + 1] - s1);
+    }
+}
+
+/* Sets corner c of triangle t to node i, whose unwrapped position in t's frame is p. */
+static void set_corner(fs_mesh *m, int32_t t, int c, int32_t i, const double p[3])
+{
+    m->tri[3 * (size_t)t + c] = i;
+    if (!m->shift)
+        return;
+    const double *q = m->pos + 3 * (size_t)i;
+    double ex = fs_domain_extent_x(&m->domain), ey = fs_domain_extent_y(&m->domain);
+    m->shift[6 * (size_t)t + 2 * c] = (int8_t)lround((p[0] - q[0]) / ex);
+    m->shift[6 * (size_t)t + 2 * c + 1] = (int8_t)lround((p[1] - q[1]) / ey);
+}
+
+static int corner_of(const fs_mesh *m, int32_t t, int32_t node)
+{
+    for (int c = 0; c < 3; c++)
+        if (m->tri[3 * (size_t)t + c] == node)
+            return c;
+    return -1;
+}
+
+/* Living triangles that have node i as a corner, ascending (a scan: the cut changes the mesh under
+ * every incremental structure). */
+static void tris_at(const fs_wedge_model *w, int32_t i, ilist *out)
+{
+    out->n = 0;
+    const fs_mesh *m = w->mesh;
+    for (int32_t t = 0; t < m->n_tris; t++)
+        if ((t >= w->n_elems || w->state[t] == FS_WEDGE_ALIVE) && corner_of(m, t, i) >= 0)
+            ilist_push(out, t);
+}
+
+/* Corner c of triangle t relative to corner cn, in the 2-D frame. */
+static void rel_2d(const fs_mesh *m, const frame *f, int32_t t, int cn, int c, double out[2])
+{
+    double a[3], b[3], d[3];
+    fs_mesh_corner(m, t, cn, a);
+    fs_mesh_corner(m, t, c, b);
+    fs_sub3(d, b, a);
+    to_2d(f, d, out);
+}
+
+/* Splits edge ab (corners ia, ib = ia + 1 of triangle t) at a + s (b - a), and the neighbour across
+ * it. Returns the new node. t keeps (.., a, p, ..) and a new triangle gets (.., p, b, ..); likewise the
+ * neighbour. */
+static int32_t split_edge(cut_state *cs, int32_t t, int ia, double s)
+{
+    fs_mesh *m = cs->w->mesh;
+    int ib = (ia + 1) % 3;
+    int32_t a = m->tri[3 * (size_t)t + ia], b = m->tri[3 * (size_t)t + ib];
+    int32_t u = m->adj[3 * (size_t)t + ia];
+    double pa[3], pb[3], p[3], q[3];
+    fs_mesh_corner(m, t, ia, pa);
+    fs_mesh_corner(m, t, ib, pb);
+    for (int k = 0; k < 3; k++)
+        p[k] = pa[k] + s * (pb[k] - pa[k]);
+    memcpy(q, p, sizeof q);
+    fs_domain_wrap(&m->domain, q);
+    if (!cs->w->flat)
+        memcpy(p, q, sizeof p);
+    int32_t i = new_node(cs, q, a, b, s);
+    int32_t t2 = new_tri(cs, t);
+    set_corner(m, t, ib, i, p);
+    set_corner(m, t2, ia, i, p);
+    normalize_shifts(m, t2);
+    mark_changed(cs, t);
+    if (u >= 0) {
+        int ua = corner_of(m, u, a), ub = corner_of(m, u, b);
+        double qa[3], qb[3], pu[3];
+        fs_mesh_corner(m, u, ua, qa);
+        fs_mesh_corner(m, u, ub, qb);
+        for (int k = 0; k < 3; k++)
+            pu[k] = qa[k] + s * (qb[k] - qa[k]);
+        if (!cs->w->flat)
+            memcpy(pu, q, sizeof pu);
+        int32_t u2 = new_tri(cs, u);
+        set_corner(m, u, ub, i, pu);
+        set_corner(m, u2, ua, i, pu);
+        normalize_shifts(m, u2);
+        mark_changed(cs, u);
+    }
+    return i;
+}
+
+/* Twice the signed area of triangle t projected into frame f. */
+static double area_2d(const fs_mesh *m, const frame *f, int32_t t)
+{
+    double a[2], b[2];
+    rel_2d(m, f, t, 0, 1, a);
+    rel_2d(m, f, t, 0, 2, b);
+    return a[0] * b[1] - a[1] * b[0];
+}
+
+/* Edge collapse (Algorithm 12): moves free node v by delta (2-D, frame f) if every triangle around
+ * it keeps COLLAPSE_MIN_AREA of its area and the node stays inside the fundamental domain.
+ * Returns true if it moved. */
+static bool collapse(cut_state *cs, const frame *f, int32_t v, const double delta[2], const uint8_t *open)
+{
+    fs_wedge_model *w = cs->w;
+    fs_mesh *m = w->mesh;
+    if (v < w->n_nodes && (open[v] || w->pinned[v] || tip_find(w, v) >= 0))
+        return false;
+    double d3[3], old[3], moved[3], wrapped[3];
+    from_2d(f, delta, d3);
+    memcpy(old, m->pos + 3 * (size_t)v, sizeof old);
+    for (int k = 0; k < 3; k++)
+        moved[k] = old[k] + d3[k];
+    memcpy(wrapped, moved, sizeof wrapped);
+    fs_domain_wrap(&m->domain, wrapped);
+    if (w->flat && (wrapped[0] != moved[0] || wrapped[1] != moved[1]))
+        return false;
+    ilist ring = {0};
+    tris_at(w, v, &ring);
+    double *before = fs_malloc(((size_t)ring.n + 1) * sizeof *before);
+    for (int32_t q = 0; q < ring.n; q++)
+        before[q] = area_2d(m, f, ring.v[q]);
+    memcpy(m->pos + 3 * (size_t)v, wrapped, sizeof wrapped);
+    bool ok = true;
+    for (int32_t q = 0; q < ring.n && ok; q++)
+        ok = area_2d(m, f, ring.v[q]) > COLLAPSE_MIN_AREA * before[q];
+    if (!ok)
+        memcpy(m->pos + 3 * (size_t)v, old, sizeof old);
+    else
+        for (int32_t q = 0; q < ring.n; q++)
+            mark_changed(cs, ring.v[q]);
+    free(before);
+    free(ring.v);
+    return ok;
+}
+
+/* One ray from n along d (2-D, frame f): splits or snaps, returns the far end of the cut (-1 when the
+ * ray leaves through a gap of the fan: nothing cut). */
+static int32_t cast_ray(cut_state *cs, const frame *f, int32_t n, const double d[2], const uint8_t *open)
+{
+    fs_wedge_model *w = cs->w;
+    fs_mesh *m = w->mesh;
+    ilist fan = {0};
+    tris_at(w, n, &fan);
+    int32_t far = -1;
+    for (int32_t q = 0; q < fan.n && far < 0; q++) {
+        int32_t t = fan.v[q];
+        int cn = corner_of(m, t, n), ia = (cn + 1) % 3, ib = (cn + 2) % 3;
+        double a[2], b[2], s;
+        rel_2d(m, f, t, cn, ia, a);
+        rel_2d(m, f, t, cn, ib, b);
+        fs_split_hit hit = fs_split_ray_sector(a, b, d, SNAP, &s);
+        if (hit == FS_SPLIT_MISS)
+            continue;
+        if (hit == FS_SPLIT_EDGE) {
+            far = split_edge(cs, t, ia, s);
+            break;
+        }
+        int c = hit == FS_SPLIT_AT_A ? ia : ib;
+        const double *pv = hit == FS_SPLIT_AT_A ? a : b;
+        far = m->tri[3 * (size_t)t + c];
+        double on_line[2], delta[2];
+        fs_split_project_onto_line(pv, d, on_line);
+        delta[0] = on_line[0] - pv[0];
+        delta[1] = on_line[1] - pv[1];
+        collapse(cs, f, far, delta, open);
+    }
+    free(fan.v);
+    return far;
+}
+
+static int32_t find_root(int32_t *parent, int32_t i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+/* Splits node v into one copy per connected sector of its fan once the edges (v, cut[k]) are cut.
+ * Returns the number of sectors (1: v stays whole). */
+static int32_t duplicate_node(cut_state *cs, int32_t v, const int32_t *cut, int32_t n_cut)
+{
+    fs_wedge_model *w = cs->w;
+    fs_mesh *m = w->mesh;
+    ilist fan = {0};
+    tris_at(w, v, &fan);
+    int32_t *parent = fs_malloc(((size_t)fan.n + 1) * sizeof *parent);
+    for (int32_t q = 0; q < fan.n; q++)
+        parent[q] = q;
+    for (int32_t q = 0; q < fan.n; q++) {
+        int32_t t = fan.v[q];
+        int c = corner_of(m, t, v);
+        for (int side = 0; side < 2; side++) {
+            int edge = side ? c : (c + 2) % 3; /* the two edges of t at v */
+            int32_t other = m->tri[3 * (size_t)t + (side ? (c + 1) % 3 : (c + 2) % 3)];
+            int32_t u = m->adj[3 * (size_t)t + edge];
+            if (u < 0)
+                continue;
+            bool is_cut = false;
+            for (int32_t k = 0; k < n_cut; k++)
+                is_cut |= cut[k] == other;
+            if (is_cut)
+                continue;
+            for (int32_t r = 0; r < fan.n; r++)
+                if (fan.v[r] == u) {
+                    int32_t x = find_root(parent, q), y = find_root(parent, r);
+                    if (x != y)
+                        parent[x > y ? x : y] = x < y ? x : y;
+                }
+        }
+    }
+    int32_t sectors = 0;
+    int32_t *copy = fs_malloc(((size_t)fan.n + 1) * sizeof *copy);
+    for (int32_t q = 0; q < fan.n; q++) {
+        int32_t r = find_root(parent, q);
+        if (r != q) {
+            copy[q] = copy[r];
+            continue;
+        }
+        copy[q] = sectors++ == 0 ? v : new_node(cs, m->pos + 3 * (size_t)v, v, v, 0.0);
+    }
+    for (int32_t q = 0; q < fan.n; q++)
+        if (copy[q] != v) {
+            int32_t t = fan.v[q];
+            m->tri[3 * (size_t)t + corner_of(m, t, v)] = copy[q];
+            mark_changed(cs, t);
+        }
+    free(copy);
+    free(parent);
+    free(fan.v);
+    return sectors;
+}
+
+/* Elements within GRIFFITH_RINGS edge rings of node n (before a cut), ascending. */
+static void griffith_region(const fs_wedge_model *w, int32_t n, ilist *out)
+{
+    uint8_t *seen_node = fs_calloc((size_t)w->n_nodes, 1), *seen_elem = fs_calloc((size_t)w->n_elems, 1);
+    ilist front = {0}, next = {0};
+    ilist_push(&front, n);
+    seen_node[n] = 1;
+    for (int ring = 0; ring < GRIFFITH_RINGS; ring++) {
+        next.n = 0;
+        for (int32_t q = 0; q < front.n; q++) {
+            int32_t i = front.v[q];
+            for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++) {
+                int32_t e = w->node_elem[p];
+                seen_elem[e] = 1;
+                for (int c = 0; c < 3; c++) {
+                    int32_t j = w->mesh->tri[3 * (size_t)e + c];
+                    if (!seen_node[j]) {
+                        seen_node[j] = 1;
+                        ilist_push(&next, j);
+                    }
+                }
+            }
+        }
+        ilist tmp = front;
+        front = next;
+        next = tmp;
+    }
+    out->n = 0;
+    for (int32_t e = 0; e < w->n_elems; e++)
+        if (seen_elem[e])
+            ilist_push(out, e);
+    free(front.v);
+    free(next.v);
+    free(seen_node);
+    free(seen_elem);
+}
+
+static double region_energy(const fs_wedge_model *w, const ilist *region, int32_t first_new)
+{
+    double e = 0.0;
+    for (int32_t q = 0; q < region->n; q++)
+        e += fs_wedge_element_energy(w, region->v[q]);
+    for (int32_t t = first_new; t < w->n_elems; t++)
+        e += fs_wedge_element_energy(w, t);
+    return e;
+}
+
+/* Bisects the one-ring of n and its neighbours down to mesh.min_size (§5.7.6). *bisected > 0 if the
+ * mesh changed. */
+static int subdivide_around(fs_wedge_model *w, int32_t n, int32_t *bisected)
+{
+    ilist list = {0};
+    const fs_mesh *m = w->mesh;
+    for (int32_t p = w->node_elem_start[n]; p < w->node_elem_start[n] + w->node_elem_count[n]; p++) {
+        int32_t e = w->node_elem[p];
+        for (int k = -1; k < 3; k++) {
+            int32_t t = k < 0 ? e : m->adj[3 * (size_t)e + k];
+            if (t >= 0 && w->state[t] == FS_WEDGE_ALIVE && fs_refine_tri_size(m, t) >= w->cfg.mesh.min_size)
+                ilist_push(&list, t);
+        }
+    }
+    *bisected = 0;
+    int rc = list.n ? fs_wedge_subdivide(w, list.v, list.n, true, bisected) : 0;
+    free(list.v);
+    return rc;
+}
+
+/* Cuts the mesh at n along the rays (3-D unit directions), updates the mesh structures, the model and
+ * the tips. ends receives the far ends of the cuts (-1 for a ray that cut nothing), lengths their
+ * lengths (cm). Returns the number of cuts made, or -1. */
+static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], int n_rays, int32_t ends[2],
+                       double lengths[2])
+{
+    fs_mesh *m = w->mesh;
+    frame f;
+    frame_at(w, n, &f);
+    uint8_t *open = open_nodes(w);
+    cut_state cs = {w, m->n_nodes, m->n_tris, {0}, NULL, {0}, fs_calloc((size_t)m->n_tris + 1, 1)};
+    int cuts = 0;
+    for (int r = 0; r < n_rays; r++) {
+        double d[2];
+        to_2d(&f, rays[r], d);
+        double len = hypot(d[0], d[1]);
+        ends[r] = -1;
+        lengths[r] = 0.0;
+        if (!(len > 0.0))
+            continue;
+        d[0] /= len;
+        d[1] /= len;
+        if (r > 0 && fs_mesh_build_adjacency(m) < 0)
+            goto fail;
+        int32_t far = cast_ray(&cs, &f, n, d, open);
+        if (far < 0 || far == n)
+            continue;
+        ends[r] = far;
+        double pn[3], pf[3], diff[3];
+        memcpy(pn, m->pos + 3 * (size_t)n, sizeof pn);
+        memcpy(pf, m->pos + 3 * (size_t)far, sizeof pf);
+        fs_domain_delta(&m->domain, pn, pf, diff);
+        lengths[r] = fs_norm3(diff);
+        cuts++;
+    }
+    if (cuts == 0) {
+        free(open);
+        free(cs.changed);
+        free(cs.node_parent.v);
+        free(cs.tri_parent.v);
+        free(cs.node_weight);
+        return 0;
+    }
+    if (fs_mesh_build_adjacency(m) < 0)
+        goto fail;
+    int32_t cut_ends[2], n_cut = 0;
+    for (int r = 0; r < n_rays; r++)
+        if (ends[r] >= 0)
+            cut_ends[n_cut++] = ends[r];
+    /* far ends first: once a far end is split, the two sides of its cut no longer share an edge */
+    int32_t sectors_far[2] = {1, 1};
+    for (int r = 0; r < n_rays; r++)
+        if (ends[r] >= 0) {
+            sectors_far[r] = duplicate_node(&cs, ends[r], &n, 1);
+            if (sectors_far[r] > 1 && fs_mesh_build_adjacency(m) < 0)
+                goto fail;
+        }
+    duplicate_node(&cs, n, cut_ends, n_cut);
+    if (fs_mesh_build_adjacency(m) < 0)
+        goto fail;
+    if (m->n_nodes == cs.n_nodes0 && m->n_tris == cs.n_tris0)
+        cuts = 0; /* the cut ran along an existing crack: nothing separated (geometry may have moved) */
+    if (m->tri_edge)
+        fs_mesh_build_edges(m);
+    if (m->ring_start)
+        fs_mesh_build_rings(m);
+
+    ilist changed = {0};
+    for (int32_t t = 0; t < cs.n_tris0; t++)
+        if (cs.changed[t])
+            ilist_push(&changed, t);
+    fs_wedge_change ch = {cs.n_nodes0, cs.n_tris0, cs.node_parent.v, cs.node_weight, cs.tri_parent.v,
+                          changed.v, changed.n};
+    int rc = fs_wedge_apply_change(w, &ch);
+    free(changed.v);
+    tip_remove(w, n);
+    for (int r = 0; r < n_rays && cuts > 0; r++) {
+        if (ends[r] < 0)
+            continue;
+        if (sectors_far[r] > 1 || (ends[r] < cs.n_nodes0 && open[ends[r]]))
+            tip_remove(w, ends[r]);
+        if (sectors_far[r] == 1)
+            tip_add(w, ends[r], rays[r]);
+    }
+    free(open);
+    free(cs.changed);
+    free(cs.node_parent.v);
+    free(cs.tri_parent.v);
+    free(cs.node_weight);
+    return rc < 0 ? -1 : cuts;
+fail:
+    free(open);
+    free(cs.changed);
+    free(cs.node_parent.v);
+    free(cs.tri_parent.v);
+    free(cs.node_weight);
+    return -1;
+}
+
+/* The in-plane crack direction at node n from the fracture plane normal m (3-D). */
+static bool crack_direction(const fs_wedge_model *w, int32_t n, const double m[3], double dir[3])
+{
+    frame f;
+    frame_at(w, n, &f);
+    double m2[2], d2[2];
+    to_2d(&f, m, m2);
+    if (!fs_split_crack_direction(m2, d2))
+        return false;
+    from_2d(&f, d2, dir);
+    return true;
+}
+
+int fs_wedge_split_event(fs_wedge_model *w, int *changed)
+{
+    *changed = 0;
+    /* tips first (Fig. 5.20) */
+    int32_t pick = -1;
+    bool from_tip = false;
+    if (w->n_tips > 0) {
+        double *r = fs_malloc((size_t)w->n_tips * sizeof *r);
+        uint64_t *id = fs_malloc((size_t)w->n_tips * sizeof *id);
+        for (int32_t k = 0; k < w->n_tips; k++) {
+            r[k] = tip_ratio(w, w->tip_node[k], NULL);
+            if (!(r[k] > 1.0))
+                r[k] = NAN;
+            id[k] = (uint64_t)w->tip_node[k];
+        }
+        int32_t k = fs_rank_pick(r, id, w->n_tips, w->cfg.preset.seed);
+        if (k >= 0) {
+            pick = w->tip_node[k];
+            from_tip = true;
+        }
+        free(r);
+        free(id);
+    }
+    if (pick < 0) {
+        uint8_t *open = open_nodes(w);
+        double *r = fs_malloc(((size_t)w->n_nodes + 1) * sizeof *r);
+        for (int32_t i = 0; i < w->n_nodes; i++) {
+            r[i] = open[i] ? NAN : node_ratio(w, i, NULL);
+            if (!(r[i] > 1.0))
+                r[i] = NAN;
+        }
+        pick = fs_rank_pick(r, NULL, w->n_nodes, w->cfg.preset.seed);
+        free(r);
+        free(open);
+    }
+    if (pick < 0)
+        return 1;
+
+    int32_t bisected = 0;
+    if (subdivide_around(w, pick, &bisected) < 0)
+        return -1;
+    if (bisected > 0) {
+        /* new midpoint nodes carry no displacement yet: a global solve, not a local relaxation */
+        *changed = 1;
+        return fs_wedge_equilibrium(w, w->time) < 0 ? -1 : 0;
+    }
+
+    double m[3], dir[3], rays[2][3];
+    if (from_tip)
+        tip_ratio(w, pick, m);
+    else
+        node_ratio(w, pick, m);
+    if (!crack_direction(w, pick, m, dir)) {
+        tip_remove(w, pick);
+        return 0;
+    }
+    int n_rays = 2;
+    memcpy(rays[0], dir, sizeof rays[0]);
+    for (int k = 0; k < 3; k++)
+        rays[1][k] = -dir[k];
+    if (from_tip) {
+        const double *in = w->tip_dir + 3 * (size_t)tip_find(w, pick);
+        double s = fs_dot3(dir, in) < 0.0 ? -1.0 : 1.0;
+        for (int k = 0; k < 3; k++)
+            rays[0][k] = s * dir[k];
+        n_rays = 1;
+    }
+
+    bool griffith = from_tip && w->cfg.fracture.griffith;
+    ilist region = {0};
+    double e1 = 0.0;
+    int32_t first_new = w->n_elems;
+    double h = w->assembled_thickness * w->thickness_factor[pick];
+    if (griffith) {
+        griffith_region(w, pick, &region);
+        e1 = region_energy(w, &region, w->n_elems);
+    }
+    int32_t ends[2];
+    double lengths[2];
+    int cuts = cut_at_node(w, pick, (const double(*)[3])rays, n_rays, ends, lengths);
+    if (cuts < 0) {
+        free(region.v);
+        return -1;
+    }
+    if (cuts == 0) {
+        /* the ray leaves through a gap of the fan: this crack cannot go on */
+        tip_remove(w, pick);
+        free(region.v);
+        return 0;
+    }
+    *changed = 1;
+    w->fractures++;
+    if (griffith) {
+        bool local = w->cfg.solver.relax == FS_RELAX_LOCAL;
+        if ((local ? fs_wedge_relax(w, NULL, 0) : fs_wedge_equilibrium(w, w->time)) < 0) {
+            free(region.v);
+            return -1;
+        }
+        double e2 = region_energy(w, &region, first_new);
+        double gc = fs_griffith_toughness_model_units(w->cfg.material.toughness);
+        if (!fs_griffith_extends(e1, e2, lengths[0] * h, gc) && tip_find(w, ends[0]) >= 0) {
+            tip_remove(w, ends[0]);
+            w->griffith_stops++;
+        }
+    }
+    free(region.v);
+    return 0;
+}

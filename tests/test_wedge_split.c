@@ -1,0 +1,293 @@
+/* Tests of wedge fracture by element splitting: crack direction under uniaxial stretch, Griffith termination, mesh validity after splits. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "base/vec.h"
+#include "check.h"
+#include "geom/delaunay.h"
+#include "geom/refine.h"
+#include "geom/sample.h"
+#include "model/wedge.h"
+
+/* A periodic 4 x 4 cm layer (E = 10 MPa, nu = 0.3, threshold 100 kPa, 0.2 cm thick) stretched along
+ * x by planar growth (r1 along x, nothing along y): uniaxial tension sigma_xx. */
+static fs_config strip_config(void)
+{
+    fs_config c = fs_config_default();
+    c.preset.model = FS_MODEL_WEDGE;
+    c.preset.seed = 3;
+    c.domain.type = FS_DOMAIN_PLANE;
+    c.domain.width = 4.0;
+    c.domain.height = 4.0;
+    c.domain.periodic_x = c.domain.periodic_y = true;
+    c.material.young = 10.0;
+    c.material.poisson = 0.3;
+    c.material.threshold = 100.0;
+    c.material.jitter = 0.1;
+    c.material.thickness = 0.2;
+    c.material.thickness_final = -1.0;
+    c.material.toughness = 0.0;
+    c.growth.type = FS_GROWTH_PLANAR;
+    c.growth.r1 = 0.05;
+    c.growth.r2 = 0.0;
+    c.growth.angle = 0.0;
+    c.fracture.method = FS_FRACTURE_SPLIT;
+    c.fracture.griffith = false;
+    c.time.end = 1.0;
+    c.time.min_step = 1e-3;
+    c.mesh.min_size = 1e3;
+    c.solver.relax = FS_RELAX_LOCAL;
+    return c;
+}
+
+static int make_mesh(const fs_config *cfg, int32_t points, fs_mesh *m)
+{
+    fs_domain d = cfg->domain;
+    fs_domain_normalize(&d);
+    fs_sample_params sp = fs_sample_params_default();
+    sp.count = points;
+    sp.seed = cfg->preset.seed;
+    fs_points pts = {0};
+    if (fs_sample_repulsion(&d, &sp, &pts) < 0)
+        return -1;
+    int rc = fs_delaunay(&d, &pts, m);
+    fs_points_free(&pts);
+    return rc;
+}
+
+/* Crack edges of a periodic mesh: boundary half-edges (each crack edge appears once per side). Sums
+ * their length and the length-weighted doubled-angle moments of their directions. */
+typedef struct {
+    double length;      /* total wall length (cm), both sides */
+    double c2, s2;      /* sum of length * cos(2 theta), length * sin(2 theta) */
+    int32_t half_edges;
+} crack_stats;
+
+static crack_stats cracks_of(const fs_mesh *m)
+{
+    crack_stats s = {0};
+    for (int32_t h = 0; h < 3 * m->n_tris; h++) {
+        if (m->adj[h] >= 0)
+            continue;
+        double a[3], b[3];
+        fs_mesh_corner(m, h / 3, h % 3, a);
+        fs_mesh_corner(m, h / 3, (h % 3 + 1) % 3, b);
+        double dx = b[0] - a[0], dy = b[1] - a[1], len = hypot(dx, dy), th = atan2(dy, dx);
+        s.length += len;
+        s.c2 += len * cos(2.0 * th);
+        s.s2 += len * sin(2.0 * th);
+        s.half_edges++;
+    }
+    return s;
+}
+
+static int32_t find_root(int32_t *parent, int32_t i)
+{
+    while (parent[i] != i)
+        i = parent[i] = parent[parent[i]];
+    return i;
+}
+
+static const double *sort_pos;
+
+static int cmp_pos(const void *a, const void *b)
+{
+    const double *p = sort_pos + 3 * (size_t)*(const int32_t *)a, *q = sort_pos + 3 * (size_t)*(const int32_t *)b;
+    for (int k = 0; k < 3; k++)
+        if (p[k] != q[k])
+            return p[k] < q[k] ? -1 : 1;
+    return 0;
+}
+
+/* Length (cm) of the longest connected crack: crack walls joined through their nodes, duplicated
+ * nodes (same position) counted as one. */
+static double longest_crack(const fs_mesh *m)
+{
+    int32_t n = m->n_nodes;
+    int32_t *parent = malloc(sizeof *parent * (size_t)n), *order = malloc(sizeof *order * (size_t)n);
+    double *len = calloc((size_t)n, sizeof *len);
+    for (int32_t i = 0; i < n; i++)
+        parent[i] = order[i] = i;
+    sort_pos = m->pos;
+    qsort(order, (size_t)n, sizeof *order, cmp_pos);
+    for (int32_t q = 1; q < n; q++)
+        if (cmp_pos(order + q - 1, order + q) == 0)
+            parent[find_root(parent, order[q])] = find_root(parent, order[q - 1]);
+    for (int32_t h = 0; h < 3 * m->n_tris; h++)
+        if (m->adj[h] < 0) {
+            int32_t a = find_root(parent, m->tri[h]), b = find_root(parent, m->tri[3 * (h / 3) + (h % 3 + 1) % 3]);
+            if (a != b)
+                parent[a] = b;
+        }
+    for (int32_t h = 0; h < 3 * m->n_tris; h++)
+        if (m->adj[h] < 0) {
+            double a[3], b[3];
+            fs_mesh_corner(m, h / 3, h % 3, a);
+            fs_mesh_corner(m, h / 3, (h % 3 + 1) % 3, b);
+            len[find_root(parent, m->tri[h])] += 0.5 * hypot(b[0] - a[0], b[1] - a[1]);
+        }
+    double best = 0.0;
+    for (int32_t i = 0; i < n; i++)
+        best = fmax(best, len[i]);
+    free(parent);
+    free(order);
+    free(len);
+    return best;
+}
+
+/* Checks the mesh is a valid cracked layer: every wedge has positive volume (positive bottom area,
+ * positive thickness), adjacency is symmetric, every edge is shared by at most two triangles (the
+ * adjacency builder fails otherwise), and every boundary half-edge (a crack wall) is matched by a
+ * wall of the same geometric edge running the other way on a duplicated node pair. */
+static void check_valid(const fs_wedge_model *w)
+{
+    const fs_mesh *m = w->mesh;
+    int32_t bad_area = 0, bad_adj = 0, unmatched = 0;
+    for (int32_t t = 0; t < m->n_tris; t++) {
+        if (!(fs_mesh_tri_area(m, t) > 0.0))
+            bad_area++;
+        for (int i = 0; i < 3; i++) {
+            int32_t u = m->adj[3 * t + i];
+            if (u < 0)
+                continue;
+            bool back = false;
+            for (int j = 0; j < 3; j++)
+                back |= m->adj[3 * u + j] == t;
+            bad_adj += !back;
+        }
+    }
+    CHECK_MSG(bad_area == 0, "%d triangles with non-positive area", (int)bad_area);
+    CHECK_MSG(bad_adj == 0, "%d one-sided adjacencies", (int)bad_adj);
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        CHECK(w->thickness_factor[i] > 0.0);
+    /* crack walls pair up: half-edge a->b on one side, b'->a' on the other, same positions */
+    for (int32_t h = 0; h < 3 * m->n_tris; h++) {
+        if (m->adj[h] >= 0)
+            continue;
+        double a[3], b[3];
+        fs_mesh_corner(m, h / 3, h % 3, a);
+        fs_mesh_corner(m, h / 3, (h % 3 + 1) % 3, b);
+        bool found = false;
+        for (int32_t g = 0; g < 3 * m->n_tris && !found; g++) {
+            if (m->adj[g] >= 0 || g == h)
+                continue;
+            double c[3], d[3];
+            fs_mesh_corner(m, g / 3, g % 3, c);
+            fs_mesh_corner(m, g / 3, (g % 3 + 1) % 3, d);
+            double dx = fs_domain_extent_x(&m->domain), dy = fs_domain_extent_y(&m->domain);
+            double ox = round((d[0] - a[0]) / dx) * dx, oy = round((d[1] - a[1]) / dy) * dy;
+            found = fabs(d[0] - ox - a[0]) < 1e-9 && fabs(d[1] - oy - a[1]) < 1e-9 &&
+                    fabs(c[0] - ox - b[0]) < 1e-9 && fabs(c[1] - oy - b[1]) < 1e-9 &&
+                    !(m->tri[g] == m->tri[(h / 3) * 3 + (h % 3 + 1) % 3] &&
+                      m->tri[(g / 3) * 3 + (g % 3 + 1) % 3] == m->tri[h]);
+        }
+        unmatched += !found;
+    }
+    CHECK_MSG(unmatched == 0, "%d crack walls without a facing wall on duplicated nodes (hanging)", (int)unmatched);
+}
+
+/* The first crack under uniaxial tension along x runs along y, and splitting keeps the mesh valid. */
+static void test_crack_perpendicular(void)
+{
+    fs_config cfg = strip_config();
+    fs_mesh m = {0};
+    CHECK(make_mesh(&cfg, 450, &m) == 0);
+    fs_wedge_model w;
+    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    int32_t nodes0 = w.n_nodes;
+    /* run until the first cracks have run */
+    CHECK(fs_wedge_simulate(&w, 0.3) == 0);
+    crack_stats s = cracks_of(&m);
+    CHECK_MSG(w.fractures > 3, "%lld splits", (long long)w.fractures);
+    CHECK_MSG(s.length > 4.0, "crack wall length %g cm", s.length);
+    /* mean doubled angle: a crack along y has theta = +-90 degrees, cos(2 theta) = -1 */
+    double mean_angle = 0.5 * atan2(s.s2, s.c2) * 57.29577951308232;
+    double off = 90.0 - fabs(mean_angle);
+    CHECK_MSG(off < 5.0, "cracks run at %.2f degrees from x (expected 90)", mean_angle);
+    double coherence = hypot(s.c2, s.s2) / s.length;
+    CHECK_MSG(coherence > 0.6, "crack directions scattered (coherence %.2f)", coherence);
+    CHECK(w.n_nodes > nodes0);
+    check_valid(&w);
+    /* the fragments separate only when nodes are duplicated: every split adds nodes */
+    CHECK(w.n_nodes - nodes0 >= w.fractures);
+    fs_wedge_free(&w);
+    fs_mesh_free(&m);
+}
+
+/* One split at an interior node: node count and wall area grow as expected. */
+static void test_single_split(void)
+{
+    fs_config cfg = strip_config();
+    fs_mesh m = {0};
+    CHECK(make_mesh(&cfg, 400, &m) == 0);
+    fs_wedge_model w;
+    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    double t = 0.0;
+    /* bring the layer over its threshold */
+    while (t < 1.0) {
+        t += 0.01;
+        CHECK(fs_wedge_equilibrium(&w, t) == 0);
+        if (fs_wedge_split_max_ratio(&w) > 1.0)
+            break;
+    }
+    CHECK(fs_wedge_split_max_ratio(&w) > 1.0);
+    int32_t nodes0 = w.n_nodes, tris0 = w.n_elems;
+    crack_stats before = cracks_of(&m);
+    int changed = 0;
+    CHECK(fs_wedge_split_event(&w, &changed) == 0);
+    CHECK(changed == 1);
+    crack_stats after = cracks_of(&m);
+    CHECK(before.half_edges == 0);
+    /* a new crack: two cuts from the node, each splitting two triangles or snapping to a node; the
+     * breaking node is duplicated once: 1 to 3 new nodes, 0 to 4 new triangles, 4 wall half-edges */
+    CHECK_MSG(w.n_nodes - nodes0 >= 1 && w.n_nodes - nodes0 <= 3, "%d new nodes", (int)(w.n_nodes - nodes0));
+    CHECK_MSG(w.n_elems - tris0 <= 4, "%d new triangles", (int)(w.n_elems - tris0));
+    CHECK_MSG(after.half_edges == 4, "%d wall half-edges", (int)after.half_edges);
+    CHECK(w.n_tips == 2);
+    /* the wall area is the cut length times the thickness on each side */
+    double area = 0.5 * after.length * cfg.material.thickness;
+    CHECK(area > 0.0 && area < 4.0 * fs_refine_tri_size(&m, 0) * cfg.material.thickness + 1.0);
+    check_valid(&w);
+    CHECK(fs_wedge_equilibrium(&w, w.time) == 0);
+    int32_t *labels = malloc(sizeof *labels * (size_t)w.n_elems);
+    CHECK(fs_wedge_fragments(&w, labels) == 1); /* a crack with two tips does not separate */
+    free(labels);
+    fs_wedge_free(&w);
+    fs_mesh_free(&m);
+}
+
+/* Griffith: a high toughness stops the crack after its first extension, a zero one does not. */
+static void test_griffith(void)
+{
+    double length[2];
+    int64_t stops[2];
+    for (int k = 0; k < 2; k++) {
+        fs_config cfg = strip_config();
+        cfg.fracture.griffith = true;
+        cfg.material.toughness = k ? 1e6 : 0.0;
+        fs_mesh m = {0};
+        CHECK(make_mesh(&cfg, 450, &m) == 0);
+        fs_wedge_model w;
+        CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+        CHECK(fs_wedge_simulate(&w, 0.3) == 0);
+        length[k] = longest_crack(&m);
+        stops[k] = w.griffith_stops;
+        fs_wedge_free(&w);
+        fs_mesh_free(&m);
+    }
+    CHECK_MSG(stops[0] == 0, "%lld tips stopped with zero toughness", (long long)stops[0]);
+    CHECK_MSG(stops[1] > 0, "no tip stopped with a high toughness");
+    CHECK_MSG(length[1] < 0.5 * length[0], "longest crack %g cm with toughness, %g cm without", length[1], length[0]);
+    printf("longest crack %g cm with toughness, %g cm without\n", length[1], length[0]);
+}
+
+int main(void)
+{
+    RUN(test_single_split);
+    RUN(test_crack_perpendicular);
+    RUN(test_griffith);
+    return check_finish();
+}
