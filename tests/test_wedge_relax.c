@@ -136,7 +136,7 @@ static void test_local_matches_global(void)
         double du = u_diff(&a, &b), ds = stress_diff(&a, &b);
         CHECK_MSG(du < 1e-6, "removal %d: displacements differ by %.3g of the largest", s, du);
         CHECK_MSG(ds < 1e-6, "removal %d: stresses differ by %.3g of the largest", s, ds);
-        CHECK_NEAR(fs_wedge_max_ratio(&a), fs_wedge_max_ratio(&b), 1e-6);
+        CHECK_NEAR(fs_wedge_max_ratio(&a), fs_wedge_max_ratio(&b), 1e-6 * fabs(fs_wedge_max_ratio(&b)));
         int ra = 0, rb = 0;
         CHECK(fs_wedge_fracture(&a, &ra) == fs_wedge_fracture(&b, &rb));
         CHECK(ra == rb);
@@ -150,11 +150,13 @@ static void test_local_matches_global(void)
         CHECK(a.state[e] == b.state[e]);
     CHECK_MSG(a.counters.local_relaxations > 0, "no relaxation stayed local (%lld fallbacks)",
               (long long)a.counters.global_fallbacks);
-    /* the next equilibrium at a new time re-factorizes the stale factor and agrees again */
+    /* the next equilibrium at a new time is solved by CG from the current state, without
+     * re-factorizing the stale factor, and agrees with the factor to the CG tolerance */
+    int64_t factorizations = a.counters.factorizations;
     CHECK(fs_wedge_equilibrium(&a, 0.9) == 0);
     CHECK(fs_wedge_equilibrium(&b, 0.9) == 0);
-    CHECK(!a.factor_stale);
-    CHECK(u_diff(&a, &b) < 1e-9);
+    CHECK(a.factor_stale && a.counters.factorizations == factorizations);
+    CHECK_MSG(u_diff(&a, &b) < 1e-6, "CG and the factor differ by %.3g of the largest", u_diff(&a, &b));
     fs_wedge_free(&a);
     fs_wedge_free(&b);
     fs_mesh_free(&m);
@@ -265,9 +267,9 @@ static void test_radius_control(void)
     CHECK(w.counters.global_fallbacks == 1);
     CHECK(w.counters.relax_retries >= 1);
     CHECK_NEAR(w.relax_radius, w.relax_unit * pow(2.0, (double)w.counters.relax_retries + 1.0), 1e-9);
-    CHECK(!w.factor_stale);
+    CHECK(w.factor_stale); /* the fallback solved by CG (see solve() in wedge.c) */
     CHECK(fs_wedge_equilibrium(&g, 1.0) == 0);
-    CHECK(u_diff(&w, &g) < 1e-12);
+    CHECK_MSG(u_diff(&w, &g) < 1e-6, "the fallback and the factor differ by %.3g of the largest", u_diff(&w, &g));
 
     e = element_near(&m, 1.0, 3.0);
     CHECK(fs_wedge_remove(&w, e) == 0);

@@ -33,4 +33,34 @@ typedef struct {
 int fs_event_find(fs_event_fn f, void *ctx, double t0, double dt_trial, double t_end, double min_step,
                   fs_event_result *out);
 
+/* design: Algorithm 5 pays one equilibrium solve for every time it tries, about ten per event when
+ * it bisects to min_step. Between two equilibria of an unchanged model whose loads are affine in time
+ * (linear elasticity, shrinkage between the knots of its piecewise linear functions), every state in
+ * between is the linear blend of the two, so the bisection can run on blends, which cost no solve.
+ * fs_event_find_estimated does that and checks the answer with exact evaluations:
+ * - forward steps as fs_event_find, each an exact call;
+ * - in a bracket lo < hi with f(lo) <= 1 < f(hi) (both exact), bisect `estimate` to min_step, giving
+ *   [a, b] with estimate(a) <= 1 < estimate(b); evaluate exactly at b (unless b is hi) and at a
+ *   (unless a is lo, or the exact value at b matched the estimate within 1e-9 relative: then the
+ *   blend is exact and so is its value at a); each exact value narrows the bracket, and when the
+ *   exact values confirm [a, b] the search ends;
+ * - after ESTIMATED_ROUNDS rounds that did not, plain bisection with exact calls (loads far from
+ *   affine).
+ * The result has the guarantees of fs_event_find (f(t) > 1 exactly at the returned t; the bracket's
+ * left end exactly at most 1, within min_step below it unless only estimates said so after a
+ * matching exact value). Typical cost: the forward steps plus one or two exact calls.
+ *
+ * Contract of the callbacks: `exact` is as fs_event_fn, and the model keeps the states of its exact
+ * calls: the latest one with a value <= 1 (or the state at t0, where the search starts) as the
+ * bracket's left end, the latest one with a value > 1 as its right end; `estimate(ctx, t)` returns the
+ * ratio of the blend of those two states at t (lo <= t <= hi), NaN on failure. The model is left in
+ * whatever state the last call made; out->t_last and out->last_exact say which. */
+typedef struct {
+    fs_event_fn exact;
+    fs_event_fn estimate;
+} fs_event_fns;
+
+int fs_event_find_estimated(const fs_event_fns *f, void *ctx, double t0, double dt_trial, double t_end,
+                            double min_step, fs_event_result *out, int *last_exact);
+
 #endif

@@ -428,6 +428,7 @@ static int build_system(fs_wedge_model *w)
     fs_sparse_builder_free(&b);
     if (rc < 0)
         return -1;
+    w->k_all_capacity = (size_t)fs_sparse_matrix_nnz(&w->k_all);
     set_view(w);
     fix_orphans(w);
     w->rhs = fs_realloc(w->rhs, ((size_t)w->n_free + 1) * sizeof *w->rhs);
@@ -538,17 +539,44 @@ static void build_rhs(fs_wedge_model *w)
     }
 }
 
+/* Scales the starting guess w->x of a CG solve by the factor that minimises the energy along it,
+ * (x . b) / (x . K x): the previous displacements fit the new loads exactly when those are the old ones
+ * times a factor (shrinkage and isogonic growth from a common start), and closely when nearly so. */
+static void scale_guess(fs_wedge_model *w)
+{
+    int32_t n = w->n_free;
+    double *kx = fs_malloc((size_t)n * sizeof *kx);
+    fs_sparse_matvec(&w->k_free, w->x, kx);
+    double xb = 0.0, xkx = 0.0;
+    for (int32_t i = 0; i < n; i++) {
+        xb += w->x[i] * w->rhs[i];
+        xkx += w->x[i] * kx[i];
+    }
+    free(kx);
+    if (xkx > 0.0 && isfinite(xb / xkx))
+        for (int32_t i = 0; i < n; i++)
+            w->x[i] *= xb / xkx;
+}
+
+/* design: with local relaxation (thesis §5.8) the mesh changes at nearly every event and the factor
+ * is dropped (fs_wedge_apply_change); re-analysing and re-factorizing it for each global solve cost
+ * 5-10 times a conjugate-gradient solve started from the current displacements, which are close to
+ * the answer (the layer is well conditioned: every wedge's bottom is held). So a global solve with
+ * a stale factor is done by CG to solver.tolerance; the factor is rebuilt only when the mesh has not
+ * changed since (fs_wedge_refactor). */
 static int solve(fs_wedge_model *w)
 {
     double t0 = fs_seconds();
     int rc = 0;
     if (w->n_free == 0) {
-    } else if (w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
+    } else if (w->cfg.solver.method == FS_SOLVER_CHOLMOD && !w->factor_stale) {
         rc = fs_cholesky_solve(w->chol, 1, w->rhs, w->x);
     } else {
         fs_cg_params p = fs_cg_params_default();
         p.tolerance = w->cfg.solver.tolerance;
         p.max_iterations = w->cfg.solver.max_iterations;
+        if (w->cfg.solver.method == FS_SOLVER_CHOLMOD)
+            scale_guess(w); /* the CG baseline stays the thesis's plain warm start */
         int it = fs_cg_solve(&w->k_free, w->rhs, w->x, p, NULL);
         if (it < 0)
             rc = -1;
@@ -749,6 +777,13 @@ static int cmp_bound_desc(const void *a, const void *b)
  * little away from the crack tip (within a few layer thicknesses), so most elements are skipped. Every
  * element that could be over 1 or tie with a maximum over 1 still gets its full bound, so the
  * candidates, the exact ratios and the decisions are the same as without. */
+/* The corners of element e need their nodal ratios recomputed. */
+static void touch_nodes(fs_wedge_model *w, int32_t e)
+{
+    for (int c = 0; c < 3; c++)
+        w->node_ratio[w->mesh->tri[3 * (size_t)e + c]] = NAN;
+}
+
 static int element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_elems)
 {
     double t0 = fs_seconds();
@@ -764,6 +799,7 @@ static int element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_ele
         int32_t e = elems ? elems[q] : q;
         if (w->state[e] != FS_WEDGE_ALIVE) {
             w->ratio[e] = NAN;
+            touch_nodes(w, e);
             continue;
         }
         double ue[18];
@@ -793,6 +829,7 @@ static int element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_ele
         }
         w->ratio[e] = bound / w->threshold[e];
         w->ratio_ref_bound[e] = w->ratio[e];
+        touch_nodes(w, e);
         memcpy(ref_u, ue, sizeof ue);
     }
     for (int32_t e = 0; e < w->n_elems; e++)
@@ -822,6 +859,16 @@ static int element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_ele
     return 0;
 }
 
+/* w->u from the free unknowns w->x and the fixed displacements w->u_fixed. */
+static void scatter_u(fs_wedge_model *w)
+{
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        for (int l = 0; l < 6; l++) {
+            int32_t g = w->dof[6 * (size_t)i + l];
+            w->u[6 * (size_t)i + l] = g < w->n_free ? w->x[g] : w->u_fixed[g - w->n_free];
+        }
+}
+
 int fs_wedge_equilibrium(fs_wedge_model *w, double t)
 {
     double h = layer_thickness(w, t);
@@ -840,13 +887,54 @@ int fs_wedge_equilibrium(fs_wedge_model *w, double t)
     }
     fixed_displacements(w, t);
     build_rhs(w);
-    if ((w->factor_stale && factorize(w, false) < 0) || solve(w) < 0)
+    if ((w->factor_stale && w->cfg.solver.relax != FS_RELAX_LOCAL && factorize(w, false) < 0) || solve(w) < 0)
         return -1;
-    for (int32_t i = 0; i < w->n_nodes; i++)
-        for (int l = 0; l < 6; l++) {
-            int32_t g = w->dof[6 * (size_t)i + l];
-            w->u[6 * (size_t)i + l] = g < w->n_free ? w->x[g] : w->u_fixed[g - w->n_free];
-        }
+    scatter_u(w);
+    w->time = t;
+    return element_ratios(w, NULL, w->n_elems);
+}
+
+void fs_wedge_snapshot_take(const fs_wedge_model *w, fs_wedge_snapshot *s)
+{
+    s->time = w->time;
+    s->thickness = w->assembled_thickness;
+    memcpy(s->coef, w->shrink_coef, sizeof w->shrink_coef);
+    memcpy(s->coef + 3, w->eigenstrain, sizeof w->eigenstrain);
+    if (s->n_free != w->n_free || !s->x) {
+        free(s->x);
+        s->x = fs_malloc(((size_t)w->n_free + 1) * sizeof *s->x);
+    }
+    if (s->n_fixed != w->n_fixed || !s->u_fixed) {
+        free(s->u_fixed);
+        s->u_fixed = fs_malloc(((size_t)w->n_fixed + 1) * sizeof *s->u_fixed);
+    }
+    s->n_free = w->n_free;
+    s->n_fixed = w->n_fixed;
+    memcpy(s->x, w->x, (size_t)w->n_free * sizeof *s->x);
+    memcpy(s->u_fixed, w->u_fixed, (size_t)w->n_fixed * sizeof *s->u_fixed);
+}
+
+void fs_wedge_snapshot_free(fs_wedge_snapshot *s)
+{
+    free(s->x);
+    free(s->u_fixed);
+    memset(s, 0, sizeof *s);
+}
+
+int fs_wedge_interpolate(fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b, double t)
+{
+    FS_ASSERT(a->n_free == w->n_free && b->n_free == w->n_free && a->n_fixed == w->n_fixed &&
+              b->n_fixed == w->n_fixed);
+    double span = b->time - a->time, s = span > 0.0 ? (t - a->time) / span : 1.0;
+    for (int k = 0; k < 3; k++) {
+        w->shrink_coef[k] = a->coef[k] + s * (b->coef[k] - a->coef[k]);
+        w->eigenstrain[k] = a->coef[3 + k] + s * (b->coef[3 + k] - a->coef[3 + k]);
+    }
+    for (int32_t i = 0; i < w->n_free; i++)
+        w->x[i] = a->x[i] + s * (b->x[i] - a->x[i]);
+    for (int32_t j = 0; j < w->n_fixed; j++)
+        w->u_fixed[j] = a->u_fixed[j] + s * (b->u_fixed[j] - a->u_fixed[j]);
+    scatter_u(w);
     w->time = t;
     return element_ratios(w, NULL, w->n_elems);
 }
@@ -938,6 +1026,9 @@ static void grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
     w->ratio = fs_realloc(w->ratio, ne * sizeof *w->ratio);
     w->stress_top = fs_realloc(w->stress_top, 18 * ne * sizeof *w->stress_top);
     w->gauss_cache = fs_realloc(w->gauss_cache, GAUSS_CACHE * ne * sizeof *w->gauss_cache);
+    w->node_ratio = fs_realloc(w->node_ratio, nn * sizeof *w->node_ratio);
+    for (size_t i = (size_t)w->n_nodes; i < nn; i++)
+        w->node_ratio[i] = NAN;
     w->ratio_lipschitz = fs_realloc(w->ratio_lipschitz, ne * sizeof *w->ratio_lipschitz);
     w->ratio_ref_bound = fs_realloc(w->ratio_ref_bound, ne * sizeof *w->ratio_ref_bound);
     w->ratio_ref_u = fs_realloc(w->ratio_ref_u, 18 * ne * sizeof *w->ratio_ref_u);
@@ -1027,6 +1118,7 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->threshold);
     free(w->ratio);
     free(w->stress_top);
+    free(w->node_ratio);
     free(w->gauss_cache);
     free(w->ratio_lipschitz);
     free(w->ratio_ref_bound);
@@ -1068,6 +1160,8 @@ static int cmp_int32(const void *a, const void *b)
  * Algorithm 6), and entries no element feeds any more become exact zeros. */
 static int update_region(fs_wedge_model *w, const int32_t *nodes, int32_t n)
 {
+    for (int32_t q = 0; q < n; q++)
+        w->node_ratio[nodes[q]] = NAN; /* their neighbourhoods changed */
     int32_t *dofs = fs_malloc(6 * (size_t)(n ? n : 1) * sizeof *dofs);
     int32_t nd = 0;
     for (int32_t q = 0; q < n; q++)
@@ -1275,11 +1369,29 @@ static void push_pair(int64_t **pairs, size_t *np, size_t *cap, int64_t key)
     (*pairs)[(*np)++] = key;
 }
 
+/* The old column of new column j after n_new free DOFs were inserted at n_free_old (-1: a new one). */
+static int32_t old_column(int32_t j, int32_t n_free_old, int32_t n_fixed_old, int32_t nf)
+{
+    if (j < n_free_old)
+        return j;
+    if (j >= nf && j - nf < n_fixed_old)
+        return n_free_old + (j - nf);
+    return -1;
+}
+
+/* design: the matrix is extended in place. The new pattern is the old one plus the (sorted, possibly
+ * repeated, possibly present) pairs of the changed elements and the diagonals of the new DOFs. Old rows
+ * keep their indices (a column holds rows no larger than itself among the free DOFs, and fixed columns
+ * hold free rows only), so every old column moves as a block to a position no lower than before: one
+ * counting pass fixes the new column starts, then the columns are moved from the last to the first,
+ * unchanged runs by memmove and columns with new pairs by a merge from the back, which never
+ * overwrites an entry not yet read. The arrays grow geometrically, so a cut costs one pass over the
+ * entries behind its first changed column and no allocation. New entries are 0 (update_region adds the
+ * contributions). */
 static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_old, const int32_t *elems,
                          int32_t n_changed)
 {
-    int32_t nf = w->n_free, order = w->n_free + w->n_fixed, shift = nf - n_free_old;
-    int32_t order_old = n_free_old + n_fixed_old;
+    int32_t nf = w->n_free, order = w->n_free + w->n_fixed;
     size_t cap = 0, np = 0;
     int64_t *pairs = NULL;
     for (int32_t q = 0; q < n_changed; q++) {
@@ -1297,49 +1409,84 @@ static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_
                 push_pair(&pairs, &np, &cap, (int64_t)col * order + row);
             }
     }
-    for (int32_t j = 0; j < order; j++) { /* diagonals of the new columns */
-        bool is_new = (j >= n_free_old && j < nf) || j - nf >= n_fixed_old;
-        if (is_new)
+    for (int32_t j = 0; j < order; j++) /* diagonals of the new columns */
+        if (old_column(j, n_free_old, n_fixed_old, nf) < 0)
             push_pair(&pairs, &np, &cap, (int64_t)j * order + j);
-    }
     qsort(pairs, np, sizeof *pairs, cmp_int64);
 
-    fs_sparse_matrix old = w->k_all, k;
-    k.n = order;
-    k.col_ptr = fs_malloc(((size_t)order + 1) * sizeof *k.col_ptr);
-    size_t cap_nz = (size_t)old.col_ptr[order_old] + np + 1;
-    k.row_idx = fs_malloc(cap_nz * sizeof *k.row_idx);
-    k.values = fs_malloc(cap_nz * sizeof *k.values);
+    fs_sparse_matrix *k = &w->k_all;
+    /* pass 1: the new column starts; pair_start[j] indexes the first pair of column j */
+    int32_t *ptr = fs_malloc(((size_t)order + 1) * sizeof *ptr);
+    size_t *pair_start = fs_malloc(((size_t)order + 1) * sizeof *pair_start);
     size_t nz = 0, pp = 0;
     for (int32_t j = 0; j < order; j++) {
-        int32_t jo = j < n_free_old ? j : (j >= nf && j - nf < n_fixed_old) ? n_free_old + (j - nf) : -1;
-        int32_t po = jo >= 0 ? old.col_ptr[jo] : 0, po_end = jo >= 0 ? old.col_ptr[jo + 1] : 0;
-        k.col_ptr[j] = (int32_t)nz;
-        for (;;) {
-            int64_t r_old = po < po_end ? (old.row_idx[po] < n_free_old ? old.row_idx[po] : old.row_idx[po] + shift) : INT64_MAX;
+        int32_t jo = old_column(j, n_free_old, n_fixed_old, nf);
+        int32_t po = jo >= 0 ? k->col_ptr[jo] : 0, po_end = jo >= 0 ? k->col_ptr[jo + 1] : 0;
+        ptr[j] = (int32_t)(nz <= INT32_MAX ? nz : INT32_MAX);
+        pair_start[j] = pp;
+        if (pp == np || pairs[pp] / order != j) {
+            nz += (size_t)(po_end - po);
+            continue;
+        }
+        while (po < po_end || (pp < np && pairs[pp] / order == j)) {
+            int64_t r_old = po < po_end ? k->row_idx[po] : INT64_MAX;
             int64_t r_new = pp < np && pairs[pp] / order == j ? pairs[pp] % order : INT64_MAX;
-            if (r_old == INT64_MAX && r_new == INT64_MAX)
-                break;
             int64_t r = r_old < r_new ? r_old : r_new;
-            double v = 0.0;
-            if (r_old == r)
-                v = old.values[po++];
+            po += r_old == r;
             while (pp < np && pairs[pp] / order == j && pairs[pp] % order == r)
                 pp++;
-            k.row_idx[nz] = (int32_t)r;
-            k.values[nz++] = v;
+            nz++;
         }
     }
-    k.col_ptr[order] = (int32_t)nz;
+    pair_start[order] = np;
     if (nz > INT32_MAX) {
         free(pairs);
-        fs_sparse_matrix_free(&k);
+        free(ptr);
+        free(pair_start);
         fs_error(FS_ERR_INTERNAL, "wedge model: the stiffness matrix outgrew 32-bit indices");
         return -1;
     }
+    ptr[order] = (int32_t)nz;
+    if (nz > w->k_all_capacity) {
+        w->k_all_capacity = nz + nz / 2;
+        k->row_idx = fs_realloc(k->row_idx, w->k_all_capacity * sizeof *k->row_idx);
+        k->values = fs_realloc(k->values, w->k_all_capacity * sizeof *k->values);
+    }
+    /* pass 2: move the columns, last first */
+    for (int32_t j = order - 1; j >= 0;) {
+        int32_t jo = old_column(j, n_free_old, n_fixed_old, nf);
+        size_t pb = pair_start[j], pe = pair_start[j + 1];
+        if (pb == pe) { /* a run of unchanged columns: j2 .. j, old columns consecutive */
+            int32_t j2 = j;
+            while (j2 > 0 && pair_start[j2 - 1] == pair_start[j2] && old_column(j2 - 1, n_free_old, n_fixed_old, nf) >= 0)
+                j2--;
+            int32_t jo2 = old_column(j2, n_free_old, n_fixed_old, nf);
+            size_t len = (size_t)(k->col_ptr[jo + 1] - k->col_ptr[jo2]);
+            memmove(k->row_idx + ptr[j2], k->row_idx + k->col_ptr[jo2], len * sizeof *k->row_idx);
+            memmove(k->values + ptr[j2], k->values + k->col_ptr[jo2], len * sizeof *k->values);
+            j = j2 - 1;
+            continue;
+        }
+        int64_t o = jo >= 0 ? k->col_ptr[jo + 1] - 1 : -1, o_begin = jo >= 0 ? k->col_ptr[jo] : 0;
+        int64_t q = (int64_t)pe - 1, d = ptr[j + 1] - 1;
+        while (o >= o_begin || q >= (int64_t)pb) {
+            int64_t r_old = o >= o_begin ? k->row_idx[o] : -1;
+            int64_t r_new = q >= (int64_t)pb ? pairs[q] % order : -1;
+            int64_t r = r_old > r_new ? r_old : r_new;
+            double v = r_old == r ? k->values[o--] : 0.0;
+            while (q >= (int64_t)pb && pairs[q] % order == r)
+                q--;
+            k->row_idx[d] = (int32_t)r;
+            k->values[d--] = v;
+        }
+        FS_ASSERT(d + 1 == ptr[j]);
+        j--;
+    }
     free(pairs);
-    fs_sparse_matrix_free(&w->k_all);
-    w->k_all = k;
+    free(pair_start);
+    free(k->col_ptr);
+    k->col_ptr = ptr;
+    k->n = order;
     set_view(w);
 
     double *load = fs_calloc((size_t)FS_WEDGE_PATTERNS * (nf ? nf : 1), sizeof *load);
@@ -1355,6 +1502,19 @@ static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_
     free(w->mark);
     w->mark = fs_calloc((size_t)order + 1, sizeof *w->mark);
     return 0;
+}
+
+/* After the sparsity pattern changed: a new analysis and factorization, or with local relaxation
+ * none (the factor is dropped and the global solves use CG until fs_wedge_refactor, see solve()). */
+static int pattern_changed(fs_wedge_model *w)
+{
+    if (w->cfg.solver.relax == FS_RELAX_LOCAL && w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
+        fs_cholesky_free(w->chol);
+        w->chol = NULL;
+        w->factor_stale = true;
+        return 0;
+    }
+    return factorize(w, true);
 }
 
 /* Marks the listed triangles and returns their descendants after one refinement call: a listed
@@ -1456,7 +1616,7 @@ int fs_wedge_subdivide(fs_wedge_model *w, const int32_t *elems, int32_t n, bool 
     w->counters.assemble_seconds += fs_seconds() - t0;
     if (rc < 0)
         return -1;
-    return factorize(w, true);
+    return pattern_changed(w);
 }
 
 int fs_wedge_refactor(fs_wedge_model *w)
@@ -1519,14 +1679,7 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
     w->counters.assemble_seconds += fs_seconds() - t0;
     if (rc < 0)
         return -1;
-    if (w->cfg.solver.relax == FS_RELAX_LOCAL && w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
-        /* local relaxation needs no factor: the next global solve analyses and factorizes afresh */
-        fs_cholesky_free(w->chol);
-        w->chol = NULL;
-        w->factor_stale = true;
-        return 0;
-    }
-    return factorize(w, true);
+    return pattern_changed(w);
 }
 
 double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e)

@@ -70,6 +70,8 @@ typedef struct {
     int64_t relax_retries;     /* local relaxations repeated at a doubled radius within one call */
     int64_t local_dofs;        /* unknowns of the local systems, summed over fs_wedge_relax calls */
     double local_seconds;      /* time in fs_wedge_relax, global fallbacks included */
+    int64_t time_steps;        /* event searches (advances of time, Algorithm 5) */
+    int64_t search_evaluations; /* their exact and estimated evaluations (fracture/event.h) */
 } fs_wedge_counters;
 
 /* The whole state of one layer. Arrays are flat and indexed by mesh node or mesh triangle (one wedge
@@ -113,6 +115,10 @@ typedef struct {
     bool lazy_ratios;            /* re-evaluate at the same time only the elements whose ratio bound
                                     could have reached 1 (wedge.c, element_ratios); set by
                                     fs_wedge_run for element removal, off by default */
+    double *node_ratio;          /* per node: the nodal ratio of the split criterion at the current
+                                    stresses (wedge_split.c), NaN when it must be recomputed: set
+                                    NaN for the corners of every element whose stresses or
+                                    neighbourhood change */
     double *ratio_lipschitz;     /* per element: bound of the change of its ratio per cm of change of
                                     its 18 nodal displacements (Euclidean norm) */
     double *ratio_ref_bound;     /* per element: its ratio bound at the last full evaluation (NaN:
@@ -127,6 +133,8 @@ typedef struct {
     fs_sparse_matrix k_all;      /* upper CSC of order n_free + n_fixed: the free-free block in the
                                     leading columns, the free-fixed coupling in the others (no
                                     fixed-fixed entries) */
+    size_t k_all_capacity;       /* entries k_all's row and value arrays have room for (they grow
+                                    geometrically as the mesh is cut, see extend_system) */
     fs_sparse_matrix k_free;     /* a view of k_all's leading n_free columns (shares its arrays) */
     double *load;                /* 6 * n_free: unit loads; 0..2 shrinkage (per unit of scale - 1),
                                     3..5 eigenstrain xx, yy, xy (per unit of eigenstrain) */
@@ -176,6 +184,28 @@ int fs_wedge_pin_top(fs_wedge_model *w, const uint8_t *pinned);
  * the solver fails (CG not converging, factorization not positive definite) or FS_ERR_DATA if an
  * element degenerates. */
 int fs_wedge_equilibrium(fs_wedge_model *w, double t);
+
+/* An equilibrium state of the model at one time, on an unchanged mesh: what fs_wedge_interpolate
+ * blends. Owns its arrays; release with fs_wedge_snapshot_free. */
+typedef struct {
+    double time;
+    double thickness;            /* the base thickness the system was assembled with */
+    double coef[6];              /* shrink_coef then eigenstrain */
+    int32_t n_free, n_fixed;
+    double *x, *u_fixed;
+} fs_wedge_snapshot;
+
+/* Copies the current state (w->time, w->x, w->u_fixed, the load coefficients) into s, reusing its
+ * arrays. */
+void fs_wedge_snapshot_take(const fs_wedge_model *w, fs_wedge_snapshot *s);
+void fs_wedge_snapshot_free(fs_wedge_snapshot *s);
+
+/* Sets the model to the state at time t between the snapshots a and b (a->time <= t <= b->time, same
+ * mesh and numbering), blending displacements and load coefficients linearly, and recomputes the
+ * stresses and ratios (no solve). Exact when the loads are affine in time on [a, b] and the stiffness
+ * is the same (linear elasticity), which holds between the knots of the shrinkage functions with a
+ * constant thickness and no background motion; otherwise an estimate. Returns 0 or -1 with fs_error. */
+int fs_wedge_interpolate(fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b, double t);
 
 /* The largest w->ratio over the living elements (-inf if none): exact when it is over 1, else an
  * upper bound that is itself at most 1. */
@@ -257,7 +287,7 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed);
 
 /* The largest nodal ratio among the split candidates at the current equilibrium (tips, and nodes off
  * every crack and boundary), -inf if none: what the split method's event search looks at. */
-double fs_wedge_split_max_ratio(const fs_wedge_model *w);
+double fs_wedge_split_max_ratio(fs_wedge_model *w);
 
 /* Re-factorizes the current matrix now (CHOLMOD; nothing with CG), dropping accumulated updates.
  * Returns 0 or -1 with fs_error. */

@@ -72,17 +72,34 @@ int fs_wedge_fracture(fs_wedge_model *w, int *removed)
 }
 
 /* The largest ratio the fracture method decides on: elements (removal) or split candidates. */
-static double max_ratio(const fs_wedge_model *w)
+static double max_ratio(fs_wedge_model *w)
 {
     return w->cfg.fracture.method == FS_FRACTURE_SPLIT ? fs_wedge_split_max_ratio(w) : fs_wedge_max_ratio(w);
 }
 
-static double event_ratio(void *ctx, double t)
+/* The event search's view of the model (fracture/event.h, fs_event_find_estimated): the exact
+ * equilibria it tried, as the bracket's ends. */
+typedef struct {
+    fs_wedge_model *w;
+    fs_wedge_snapshot lo, hi;
+} search_ctx;
+
+static double exact_ratio(void *ctx, double t)
 {
-    fs_wedge_model *w = ctx;
-    if (fs_wedge_equilibrium(w, t) < 0)
+    search_ctx *c = ctx;
+    if (fs_wedge_equilibrium(c->w, t) < 0)
         return NAN;
-    return max_ratio(w);
+    double r = max_ratio(c->w);
+    fs_wedge_snapshot_take(c->w, r > 1.0 ? &c->hi : &c->lo);
+    return r;
+}
+
+static double estimated_ratio(void *ctx, double t)
+{
+    search_ctx *c = ctx;
+    if (fs_wedge_interpolate(c->w, &c->lo, &c->hi, t) < 0)
+        return NAN;
+    return max_ratio(c->w);
 }
 
 static void report(const fs_wedge_model *w, double t_end)
@@ -104,14 +121,17 @@ int fs_wedge_simulate(fs_wedge_model *w, double t_end)
     double min_step = w->cfg.time.min_step;
     if (fs_wedge_equilibrium(w, w->time) < 0)
         return -1;
+    search_ctx search = {.w = w};
+    const fs_event_fns fns = {exact_ratio, estimated_ratio};
     double last_event = w->time, dt_trial = fmax(min_step, (t_end - w->time) / 32.0);
+    int rc = 0;
     for (;;) {
         while (max_ratio(w) > 1.0) {
             int removed = 0, changed = 1, tips = w->n_tips;
             bool split = w->cfg.fracture.method == FS_FRACTURE_SPLIT;
-            int rc = split ? fs_wedge_split_event(w, &changed) : fs_wedge_fracture(w, &removed);
+            rc = split ? fs_wedge_split_event(w, &changed) : fs_wedge_fracture(w, &removed);
             if (rc < 0)
-                return -1;
+                goto done;
             if (rc == 1)
                 break;
             if (!changed) {
@@ -120,24 +140,37 @@ int fs_wedge_simulate(fs_wedge_model *w, double t_end)
                 continue;  /* a tip was retired: the next candidate */
             }
             bool local = (removed || split) && w->cfg.solver.relax == FS_RELAX_LOCAL;
-            if ((local ? fs_wedge_relax(w, NULL, 0) : fs_wedge_equilibrium(w, w->time)) < 0)
-                return -1;
+            if ((rc = local ? fs_wedge_relax(w, NULL, 0) : fs_wedge_equilibrium(w, w->time)) < 0)
+                goto done;
             report(w, t_end);
         }
+        rc = 0;
         if (w->time >= t_end)
             break;
         fs_event_result r;
-        if (fs_event_find(event_ratio, w, w->time, dt_trial, t_end, min_step, &r) < 0)
-            return -1;
-        if (r.t_last != r.t && fs_wedge_equilibrium(w, r.t) < 0)
-            return -1;
+        int last_exact;
+        fs_wedge_snapshot_take(w, &search.lo);
+        if ((rc = fs_event_find_estimated(&fns, &search, w->time, dt_trial, t_end, min_step, &r, &last_exact)) < 0)
+            goto done;
+        w->counters.time_steps++;
+        w->counters.search_evaluations += r.evaluations;
+        /* the exact equilibrium at r.t, unless the last call left the model there */
+        if (r.found && !(last_exact && r.t_last == r.t)) {
+            rc = search.hi.thickness == w->assembled_thickness ? fs_wedge_interpolate(w, &search.hi, &search.hi, r.t)
+                                                                : fs_wedge_equilibrium(w, r.t);
+            if (rc < 0)
+                goto done;
+        }
         report(w, t_end);
         if (!r.found)
             break;
         dt_trial = fmax(min_step, 0.5 * (r.t - last_event));
         last_event = r.t;
     }
-    return 0;
+done:
+    fs_wedge_snapshot_free(&search.lo);
+    fs_wedge_snapshot_free(&search.hi);
+    return rc < 0 ? -1 : 0;
 }
 
 int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, fs_stats *stats)
@@ -156,6 +189,9 @@ int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, f
         fs_debug("wedge: %lld splits, %lld tips retired by Griffith, %d tips left; relaxations %lld local, "
                  "%lld global", (long long)w.fractures, (long long)w.griffith_stops, (int)w.n_tips,
                  (long long)w.counters.local_relaxations, (long long)w.counters.global_fallbacks);
+        fs_debug("wedge: %lld time steps, %lld event-search evaluations; local relaxation %.2f s, %lld unknowns, "
+                 "%lld retries", (long long)c->time_steps, (long long)c->search_evaluations, c->local_seconds,
+                 (long long)c->local_dofs, (long long)c->relax_retries);
         fs_debug("wedge: %lld removals, %lld subdivisions, %lld solves (%.2f s), %lld factorizations (%.2f s), "
                  "%lld analyses (%.2f s), %lld updates (%.2f s), assembly %.2f s, stresses %.2f s, "
                  "%lld CG iterations",

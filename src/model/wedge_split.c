@@ -179,6 +179,16 @@ static double node_ratio(const fs_wedge_model *w, int32_t i, double m[3])
     return sigma[0] / (thr / count);
 }
 
+/* node_ratio without the direction, from the cache w->node_ratio where it is valid. */
+static double cached_node_ratio(fs_wedge_model *w, int32_t i)
+{
+    if (isnan(w->node_ratio[i])) {
+        double r = node_ratio(w, i, NULL);
+        w->node_ratio[i] = isnan(r) ? -INFINITY : r;
+    }
+    return w->node_ratio[i];
+}
+
 /* open[i] = 1 for a node on a boundary edge of the mesh: a crack wall, a tip or the domain's border. */
 static uint8_t *open_nodes(const fs_wedge_model *w)
 {
@@ -192,7 +202,7 @@ static uint8_t *open_nodes(const fs_wedge_model *w)
     return open;
 }
 
-double fs_wedge_split_max_ratio(const fs_wedge_model *w)
+double fs_wedge_split_max_ratio(fs_wedge_model *w)
 {
     double best = -INFINITY;
     for (int32_t k = 0; k < w->n_tips; k++)
@@ -200,7 +210,7 @@ double fs_wedge_split_max_ratio(const fs_wedge_model *w)
     uint8_t *open = open_nodes(w);
     for (int32_t i = 0; i < w->n_nodes; i++)
         if (!open[i])
-            best = fmax(best, node_ratio(w, i, NULL));
+            best = fmax(best, cached_node_ratio(w, i));
     free(open);
     return best;
 }
@@ -749,7 +759,7 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed)
         uint8_t *open = open_nodes(w);
         double *r = fs_malloc(((size_t)w->n_nodes + 1) * sizeof *r);
         for (int32_t i = 0; i < w->n_nodes; i++) {
-            r[i] = open[i] ? NAN : node_ratio(w, i, NULL);
+            r[i] = open[i] ? NAN : cached_node_ratio(w, i);
             if (!(r[i] > 1.0))
                 r[i] = NAN;
         }
