@@ -461,6 +461,73 @@ static void test_event_brute_force(void)
     }
 }
 
+/* A model for fs_event_find_estimated: the exact ratio is ratio_at (kind 3: affine, t / t_star), the
+ * estimate blends the exact values at the bracket's ends linearly, as the wedge model blends
+ * equilibria. */
+typedef struct {
+    ratio_ctx exact;
+    double lo_t, lo_v, hi_t, hi_v;
+    int exact_calls;
+} blend_ctx;
+
+static double blend_exact(void *ctx, double t)
+{
+    blend_ctx *b = ctx;
+    b->exact_calls++;
+    double v = b->exact.kind == 3 ? t / b->exact.t_star : ratio_fn(&b->exact, t);
+    if (v > 1.0)
+        b->hi_t = t, b->hi_v = v;
+    else
+        b->lo_t = t, b->lo_v = v;
+    return v;
+}
+
+static double blend_estimate(void *ctx, double t)
+{
+    blend_ctx *b = ctx;
+    CHECK(b->lo_t <= t && t <= b->hi_t);
+    return b->lo_v + (t - b->lo_t) / (b->hi_t - b->lo_t) * (b->hi_v - b->lo_v);
+}
+
+/* The estimated search finds what a brute-force scan finds, within min_step, whether the blend is
+ * exact (affine ratio: then with at most two exact calls after the forward steps) or not. */
+static void test_event_estimated(void)
+{
+    static const struct { int kind; double t_star, t0, dt; } cases[] = {
+        {3, 0.7, 0.0, 0.01}, {3, 2.5, 1.0, 0.3}, {0, 0.7, 0.0, 0.01}, {0, 3.3, 1.0, 0.05},
+        {1, 2.45, 2.0, 0.01}, {1, 5.0, 2.0, 0.3}, {2, 0.0, 0.0, 0.05}, {2, 0.0, 0.5, 0.001},
+    };
+    const double min_step = 1e-4, t_end = 20.0;
+    const fs_event_fns fns = {blend_exact, blend_estimate};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        double brute = -1.0;
+        int forward_steps = 0;
+        for (double dt = cases[k].dt, t = cases[k].t0; t < t_end; t += dt, dt *= 2.0)
+            forward_steps++;
+        for (long i = 1; cases[k].t0 + (double)i * min_step <= t_end; i++) {
+            double t = cases[k].t0 + (double)i * min_step;
+            double v = cases[k].kind == 3 ? t / cases[k].t_star : ratio_at(cases[k].kind, cases[k].t_star, t);
+            if (v > 1.0) {
+                brute = t;
+                break;
+            }
+        }
+        blend_ctx b = {{cases[k].kind, cases[k].t_star, 0, 0, 0}, cases[k].t0, 0.0, t_end, 0.0, 0};
+        b.lo_v = cases[k].kind == 3 ? cases[k].t0 / cases[k].t_star : ratio_at(cases[k].kind, cases[k].t_star, cases[k].t0);
+        fs_event_result r;
+        int last_exact;
+        CHECK(fs_event_find_estimated(&fns, &b, cases[k].t0, cases[k].dt, t_end, min_step, &r, &last_exact) == 0);
+        CHECK_MSG(r.found && brute > 0 && fabs(r.t - brute) <= min_step,
+                  "case %zu: estimated %.9g, brute force %.9g", k, r.t, brute);
+        double exact_v = cases[k].kind == 3 ? r.t / cases[k].t_star : ratio_at(cases[k].kind, cases[k].t_star, r.t);
+        CHECK(r.ratio == exact_v && r.ratio > 1.0);
+        CHECK(r.t - r.t_before < min_step);
+        if (cases[k].kind == 3)
+            CHECK_MSG(b.exact_calls <= forward_steps + 2, "case %zu: %d exact calls", k, b.exact_calls);
+        CHECK_MSG(b.exact_calls < 40, "case %zu: %d exact calls", k, b.exact_calls);
+    }
+}
+
 static void test_event_errors(void)
 {
     ratio_ctx c = {0, 0.7, 0, 0, 0};
@@ -494,6 +561,7 @@ int main(void)
     RUN(test_event_none);
     RUN(test_event_logarithmic);
     RUN(test_event_brute_force);
+    RUN(test_event_estimated);
     RUN(test_event_errors);
     return check_finish();
 }
