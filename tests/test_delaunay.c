@@ -925,9 +925,91 @@ static void test_adjacency(void)
     CHECK(m.pos == NULL && m.n_nodes == 0);
 }
 
+/* Adds a node at position p (copying nothing else). */
+static int32_t add_node(fs_mesh *m, const double p[3])
+{
+    m->pos = realloc(m->pos, 3 * ((size_t)m->n_nodes + 1) * sizeof *m->pos);
+    memcpy(m->pos + 3 * (size_t)m->n_nodes, p, 3 * sizeof *p);
+    return m->n_nodes++;
+}
+
+/* Appends triangle (a, b, c) with zero shifts. */
+static void add_tri(fs_mesh *m, int32_t a, int32_t b, int32_t c)
+{
+    m->tri = realloc(m->tri, 3 * ((size_t)m->n_tris + 1) * sizeof *m->tri);
+    m->shift = realloc(m->shift, 6 * ((size_t)m->n_tris + 1) * sizeof *m->shift);
+    int32_t *t = m->tri + 3 * (size_t)m->n_tris;
+    t[0] = a, t[1] = b, t[2] = c;
+    memset(m->shift + 6 * (size_t)m->n_tris, 0, 6 * sizeof *m->shift);
+    m->n_tris++;
+}
+
+/* Does the adjacency equal that of a full rebuild? */
+static bool adjacency_as_rebuilt(const fs_mesh *m)
+{
+    int32_t *local = malloc(3 * (size_t)m->n_tris * sizeof *local);
+    memcpy(local, m->adj, 3 * (size_t)m->n_tris * sizeof *local);
+    fs_mesh copy = *m;
+    copy.adj = NULL;
+    bool same = fs_mesh_build_adjacency(&copy) == 0 &&
+                memcmp(local, copy.adj, 3 * (size_t)m->n_tris * sizeof *local) == 0;
+    free(copy.adj);
+    free(local);
+    return same;
+}
+
+/* Local changes of a torus mesh (off the seams, where the shifts are zero): a node inserted in a
+ * triangle (one changed, two new), a triangle cut loose by giving it copies of two of its nodes, a
+ * whole batch of both at once. After each, fs_mesh_update_adjacency equals a full rebuild. */
+static void test_update_adjacency(void)
+{
+    double w = 6.0, h = 5.0;
+    fs_domain d = plane_domain(w, h, true, true);
+    fs_points pts = uniform_points(600, w, h, 31);
+    fs_mesh m;
+    CHECK(fs_delaunay(&d, &pts, &m) == 0);
+    free(pts.p);
+    int changes = 0;
+    for (int round = 0; round < 3; round++) {
+        int32_t n_tris_before = m.n_tris, changed[40], n_changed = 0;
+        for (int32_t t = 7 + 13 * round; t < n_tris_before && n_changed < (round == 2 ? 40 : 1); t += 37) {
+            bool seam = false;
+            for (int k = 0; k < 6; k++)
+                seam |= m.shift[6 * (size_t)t + k] != 0;
+            if (seam)
+                continue;
+            int32_t *c = m.tri + 3 * (size_t)t, a = c[0], b = c[1], e = c[2];
+            if ((t / 37) % 2 == 0) { /* insert the centroid */
+                double p[3] = {0, 0, 0};
+                for (int k = 0; k < 3; k++)
+                    for (int l = 0; l < 3; l++)
+                        p[l] += m.pos[3 * (size_t)c[k] + l] / 3.0;
+                int32_t q = add_node(&m, p);
+                c = m.tri + 3 * (size_t)t;
+                c[2] = q;
+                add_tri(&m, b, e, q);
+                add_tri(&m, e, a, q);
+            } else { /* cut it loose at two corners */
+                int32_t a2 = add_node(&m, m.pos + 3 * (size_t)a), b2 = add_node(&m, m.pos + 3 * (size_t)b);
+                c = m.tri + 3 * (size_t)t;
+                c[0] = a2, c[1] = b2;
+            }
+            changed[n_changed++] = t;
+        }
+        CHECK(n_changed > 0);
+        CHECK(fs_mesh_update_adjacency(&m, n_tris_before, changed, n_changed) == 0);
+        CHECK_MSG(adjacency_as_rebuilt(&m), "round %d: %d changed, %d new triangles", round, (int)n_changed,
+                  (int)(m.n_tris - n_tris_before));
+        changes += n_changed;
+    }
+    CHECK(changes > 10);
+    fs_mesh_free(&m);
+}
+
 int main(void)
 {
     RUN(test_adjacency);
+    RUN(test_update_adjacency);
     RUN(test_plane_random);
     RUN(test_plane_lattice);
     RUN(test_plane_square_grid);

@@ -212,36 +212,14 @@ static void sort_node_keys(uint64_t *key, int32_t *val, int32_t n, int low_bits,
  * two are rare: tiny periodic meshes, where one pair of nodes has several edges, or a non-manifold
  * mesh. A second half-edge along the same edge in the same direction means three triangles on one
  * edge or two facing opposite ways. */
-int fs_mesh_build_adjacency(fs_mesh *m)
+/* Pairs the half-edges val[0 .. n) (their adj entries -1 on entry) whose keys (see below) key[] holds,
+ * sorted; shifted: the mesh has image offsets. Returns 0, or -1 with fs_error for a non-manifold
+ * edge. */
+static int pair_sorted(fs_mesh *m, const uint64_t *key, const int32_t *val, int32_t n, bool shifted)
 {
-    if ((int64_t)m->n_tris * 3 > INT32_MAX) {
-        fs_error(FS_ERR_DATA, "mesh: %d triangles are too many", (int)m->n_tris);
-        return -1;
-    }
-    int32_t nh = 3 * m->n_tris;
-    free(m->adj);
-    m->adj = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->adj);
-    int bits = 1;
-    while (bits < 31 && ((int64_t)1 << bits) < m->n_nodes)
-        bits++;
-    bool shifted = false;
-    for (int64_t k = 0; m->shift && k < 6 * (int64_t)m->n_tris && !shifted; k++)
-        shifted = m->shift[k] != 0;
-    /* key: the two nodes, then one bit for the direction (set when running from the larger) */
-    uint64_t *key = fs_malloc((size_t)(nh ? nh : 1) * sizeof *key);
-    int32_t *val = fs_malloc((size_t)(nh ? nh : 1) * sizeof *val);
-    for (int32_t h = 0; h < nh; h++) {
-        uint64_t a = (uint64_t)m->tri[h], b = (uint64_t)m->tri[3 * (h / 3) + (h % 3 + 1) % 3];
-        key[h] = a <= b ? ((a << bits | b) << 1) : ((b << bits | a) << 1) | 1;
-        val[h] = h;
-        m->adj[h] = -1;
-    }
-    sort_node_keys(key, val, nh, bits + 1, m->n_nodes);
-
-    int rc = 0;
-    for (int32_t i = 0; i < nh && rc == 0;) {
+    for (int32_t i = 0; i < n;) {
         int32_t j = i + 1;
-        while (j < nh && key[j] >> 1 == key[i] >> 1)
+        while (j < n && key[j] >> 1 == key[i] >> 1)
             j++;
         if (!shifted && j - i <= 2 && key[i] != key[j - 1]) {
             /* the common case off the seams: one half-edge each way */
@@ -254,7 +232,7 @@ int fs_mesh_build_adjacency(fs_mesh *m)
             i = j;
             continue;
         }
-        for (int32_t p = i; p < j && rc == 0; p++) {
+        for (int32_t p = i; p < j; p++) {
             half_edge e = half_edge_of(m, val[p]);
             for (int32_t q = p + 1; q < j; q++) {
                 half_edge f = half_edge_of(m, val[q]);
@@ -264,8 +242,7 @@ int fs_mesh_build_adjacency(fs_mesh *m)
                              "mesh: edge (%d, %d) of triangle %d is shared by more than two triangles or by two "
                              "facing opposite ways (non-manifold)",
                              (int)e.from, (int)e.to, (int)(val[p] / 3));
-                    rc = -1;
-                    break;
+                    return -1;
                 }
                 if (pair) {
                     m->adj[val[p]] = val[q] / 3;
@@ -275,9 +252,140 @@ int fs_mesh_build_adjacency(fs_mesh *m)
         }
         i = j;
     }
+    return 0;
+}
+
+/* Bits for a node index of the mesh. */
+static int node_bits(const fs_mesh *m)
+{
+    int bits = 1;
+    while (bits < 31 && ((int64_t)1 << bits) < m->n_nodes)
+        bits++;
+    return bits;
+}
+
+/* The key of half-edge h: the two nodes, then one bit for the direction (set when running from the
+ * larger). */
+static uint64_t half_edge_key(const fs_mesh *m, int32_t h, int bits)
+{
+    uint64_t a = (uint64_t)m->tri[h], b = (uint64_t)m->tri[3 * (h / 3) + (h % 3 + 1) % 3];
+    return a <= b ? ((a << bits | b) << 1) : ((b << bits | a) << 1) | 1;
+}
+
+static bool mesh_shifted(const fs_mesh *m)
+{
+    for (int64_t k = 0; m->shift && k < 6 * (int64_t)m->n_tris; k++)
+        if (m->shift[k] != 0)
+            return true;
+    return false;
+}
+
+/* design: every half-edge gets the key (smaller node, larger node, direction); a stable sort of
+ * the keys (sort_node_keys: one counting pass on the smaller node, then a node's few keys) brings
+ * the two half-edges of an edge together, and a run of equal node pairs is matched by image
+ * offset and direction: a partner runs the other way with the opposite offset. Runs longer than
+ * two are rare: tiny periodic meshes, where one pair of nodes has several edges, or a non-manifold
+ * mesh. A second half-edge along the same edge in the same direction means three triangles on one
+ * edge or two facing opposite ways. */
+int fs_mesh_build_adjacency(fs_mesh *m)
+{
+    if ((int64_t)m->n_tris * 3 > INT32_MAX) {
+        fs_error(FS_ERR_DATA, "mesh: %d triangles are too many", (int)m->n_tris);
+        return -1;
+    }
+    int32_t nh = 3 * m->n_tris;
+    free(m->adj);
+    m->adj = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->adj);
+    int bits = node_bits(m);
+    uint64_t *key = fs_malloc((size_t)(nh ? nh : 1) * sizeof *key);
+    int32_t *val = fs_malloc((size_t)(nh ? nh : 1) * sizeof *val);
+    for (int32_t h = 0; h < nh; h++) {
+        key[h] = half_edge_key(m, h, bits);
+        val[h] = h;
+        m->adj[h] = -1;
+    }
+    sort_node_keys(key, val, nh, bits + 1, m->n_nodes);
+    int rc = pair_sorted(m, key, val, nh, mesh_shifted(m));
     free(key);
     free(val);
     return rc;
+}
+
+static int cmp_keyed(const void *pa, const void *pb)
+{
+    return keyed_cmp(pa, pb);
+}
+
+/* design: a local change (an edge split, a node duplicated) leaves the adjacency of every triangle
+ * away from it as it was. The half-edges to pair again are those of the listed and the new
+ * triangles, and those of their neighbours (by the adjacency before the change) that point at a
+ * listed triangle: any edge whose partner may differ has one of them on a side. They are matched
+ * exactly as fs_mesh_build_adjacency matches all of them, so the result is the same. */
+int fs_mesh_update_adjacency(fs_mesh *m, int32_t n_tris_before, const int32_t *changed, int32_t n_changed)
+{
+    if ((int64_t)m->n_tris * 3 > INT32_MAX) {
+        fs_error(FS_ERR_DATA, "mesh: %d triangles are too many", (int)m->n_tris);
+        return -1;
+    }
+    m->adj = fs_realloc(m->adj, (3 * (size_t)m->n_tris + 1) * sizeof *m->adj);
+    uint8_t *dirty = fs_calloc((size_t)m->n_tris + 1, 1);
+    int32_t n_dirty = 0;
+    int32_t *tris = fs_malloc(((size_t)n_changed + (size_t)(m->n_tris - n_tris_before) + 1) * sizeof *tris);
+    for (int32_t q = 0; q < n_changed; q++)
+        if (!dirty[changed[q]]) {
+            dirty[changed[q]] = 1;
+            tris[n_dirty++] = changed[q];
+        }
+    for (int32_t t = n_tris_before; t < m->n_tris; t++) {
+        dirty[t] = 1;
+        tris[n_dirty++] = t;
+        for (int k = 0; k < 3; k++)
+            m->adj[3 * (size_t)t + k] = -1;
+    }
+    int32_t cap = 6 * n_dirty + 1, nh = 0;
+    keyed *kv = fs_malloc((size_t)cap * sizeof *kv);
+    int bits = node_bits(m);
+    for (int32_t q = 0; q < n_dirty; q++) {
+        int32_t t = tris[q];
+        for (int k = 0; k < 3; k++) {
+            int32_t h = 3 * t + k, u = m->adj[h];
+            if (u >= 0 && !dirty[u])
+                for (int l = 0; l < 3; l++) {
+                    int32_t g = 3 * u + l;
+                    if (m->adj[g] == t) {
+                        m->adj[g] = -1;
+                        kv[nh++] = (keyed){half_edge_key(m, g, bits), g};
+                    }
+                }
+            m->adj[h] = -1;
+            kv[nh++] = (keyed){half_edge_key(m, h, bits), h};
+        }
+    }
+    qsort(kv, (size_t)nh, sizeof *kv, cmp_keyed);
+    uint64_t *key = fs_malloc(((size_t)nh + 1) * sizeof *key);
+    int32_t *val = fs_malloc(((size_t)nh + 1) * sizeof *val);
+    for (int32_t i = 0; i < nh; i++) {
+        key[i] = kv[i].key;
+        val[i] = kv[i].val;
+    }
+    int rc = pair_sorted(m, key, val, nh, mesh_shifted(m));
+    free(key);
+    free(val);
+    free(kv);
+    free(tris);
+    free(dirty);
+    return rc;
+}
+
+void fs_mesh_drop_derived(fs_mesh *m)
+{
+    free(m->edge);
+    free(m->edge_tri);
+    free(m->tri_edge);
+    free(m->ring_start);
+    free(m->ring_tri);
+    m->edge = m->edge_tri = m->tri_edge = m->ring_start = m->ring_tri = NULL;
+    m->n_edges = 0;
 }
 
 void fs_mesh_build_edges(fs_mesh *m)

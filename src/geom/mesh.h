@@ -50,6 +50,17 @@ void fs_mesh_free(fs_mesh *m);
  * more than two triangles (non-manifold). */
 int fs_mesh_build_adjacency(fs_mesh *m);
 
+/* Brings adj up to a local change: triangles n_tris_before .. n_tris - 1 are new, the listed ones
+ * (below n_tris_before, repeats allowed) changed corners or shifts, and adj was valid for the mesh
+ * before the change. The result equals fs_mesh_build_adjacency's; the cost is that of the listed
+ * triangles and their neighbours (plus a pass over a byte per triangle). Returns 0, or -1 with
+ * fs_error(FS_ERR_DATA) for a non-manifold edge. */
+int fs_mesh_update_adjacency(fs_mesh *m, int32_t n_tris_before, const int32_t *changed, int32_t n_changed);
+
+/* Frees the edge arrays and the rings (after a change that invalidates them, for users that do not
+ * need them; fs_mesh_build_edges and fs_mesh_build_rings make them again). */
+void fs_mesh_drop_derived(fs_mesh *m);
+
 /* Fills the edge arrays. Requires adjacency. */
 void fs_mesh_build_edges(fs_mesh *m);
 

@@ -275,12 +275,42 @@ typedef struct {
     double *node_weight; /* per new node */
     ilist tri_parent;    /* per new triangle */
     uint8_t *changed;    /* per pre-cut triangle */
+    ilist changed_list;  /* the pre-cut triangles flagged in changed */
+    int32_t n_tris_adj;  /* triangles the adjacency was last brought up to date for */
 } cut_state;
 
 static void mark_changed(cut_state *cs, int32_t t)
 {
-    if (t < cs->n_tris0)
+    if (t < cs->n_tris0 && !cs->changed[t]) {
         cs->changed[t] = 1;
+        ilist_push(&cs->changed_list, t);
+    }
+}
+
+static void cut_free(cut_state *cs)
+{
+    free(cs->changed);
+    free(cs->changed_list.v);
+    free(cs->node_parent.v);
+    free(cs->tri_parent.v);
+    free(cs->node_weight);
+}
+
+/* The mesh's adjacency after the changes of the cut so far (fs_mesh_update_adjacency: the cost is
+ * that of the changed triangles): every triangle the cut changed or made is listed, those made since
+ * the last update as new. */
+static int update_adjacency(cut_state *cs)
+{
+    fs_mesh *m = cs->w->mesh;
+    ilist list = {0};
+    for (int32_t q = 0; q < cs->changed_list.n; q++)
+        ilist_push(&list, cs->changed_list.v[q]);
+    for (int32_t t = cs->n_tris0; t < cs->n_tris_adj; t++)
+        ilist_push(&list, t);
+    int rc = fs_mesh_update_adjacency(m, cs->n_tris_adj, list.v, list.n);
+    cs->n_tris_adj = m->n_tris;
+    free(list.v);
+    return rc;
 }
 
 static int32_t new_node(cut_state *cs, const double pos[3], int32_t a, int32_t b, double s)
@@ -630,7 +660,7 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
     frame f;
     frame_at(w, n, &f);
     uint8_t *open = open_nodes(w);
-    cut_state cs = {w, m->n_nodes, m->n_tris, {0}, NULL, {0}, fs_calloc((size_t)m->n_tris + 1, 1)};
+    cut_state cs = {w, m->n_nodes, m->n_tris, {0}, NULL, {0}, fs_calloc((size_t)m->n_tris + 1, 1), {0}, m->n_tris};
     int cuts = 0;
     for (int r = 0; r < n_rays; r++) {
         double d[2];
@@ -642,7 +672,7 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
             continue;
         d[0] /= len;
         d[1] /= len;
-        if (r > 0 && fs_mesh_build_adjacency(m) < 0)
+        if (r > 0 && update_adjacency(&cs) < 0)
             goto fail;
         int32_t far = cast_ray(&cs, &f, n, d, open);
         if (far < 0 || far == n)
@@ -657,13 +687,10 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
     }
     if (cuts == 0) {
         free(open);
-        free(cs.changed);
-        free(cs.node_parent.v);
-        free(cs.tri_parent.v);
-        free(cs.node_weight);
+        cut_free(&cs);
         return 0;
     }
-    if (fs_mesh_build_adjacency(m) < 0)
+    if (update_adjacency(&cs) < 0)
         goto fail;
     int32_t cut_ends[2], n_cut = 0;
     for (int r = 0; r < n_rays; r++)
@@ -674,18 +701,15 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
     for (int r = 0; r < n_rays; r++)
         if (ends[r] >= 0) {
             sectors_far[r] = duplicate_node(&cs, ends[r], &n, 1);
-            if (sectors_far[r] > 1 && fs_mesh_build_adjacency(m) < 0)
+            if (sectors_far[r] > 1 && update_adjacency(&cs) < 0)
                 goto fail;
         }
     duplicate_node(&cs, n, cut_ends, n_cut);
-    if (fs_mesh_build_adjacency(m) < 0)
+    if (update_adjacency(&cs) < 0)
         goto fail;
     if (m->n_nodes == cs.n_nodes0 && m->n_tris == cs.n_tris0)
         cuts = 0; /* the cut ran along an existing crack: nothing separated (geometry may have moved) */
-    if (m->tri_edge)
-        fs_mesh_build_edges(m);
-    if (m->ring_start)
-        fs_mesh_build_rings(m);
+    fs_mesh_drop_derived(m); /* the wedge model uses neither edges nor rings */
 
     ilist changed = {0};
     for (int32_t t = 0; t < cs.n_tris0; t++)
@@ -705,17 +729,11 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
             tip_add(w, ends[r], rays[r]);
     }
     free(open);
-    free(cs.changed);
-    free(cs.node_parent.v);
-    free(cs.tri_parent.v);
-    free(cs.node_weight);
+    cut_free(&cs);
     return rc < 0 ? -1 : cuts;
 fail:
     free(open);
-    free(cs.changed);
-    free(cs.node_parent.v);
-    free(cs.tri_parent.v);
-    free(cs.node_weight);
+    cut_free(&cs);
     return -1;
 }
 
