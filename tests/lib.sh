@@ -30,6 +30,18 @@ expect_png() {
     if [ "$got" = "$2 $3 $4 $5" ]; then ok "$(basename "$1") is ${2}x$3, $4-bit, colour type $5"
     else not_ok "$(basename "$1"): header '$got', expected '$2 $3 $4 $5'"; fi
 }
+# json_get FILE PATH: prints the value at PATH (keys joined by dots: maps.height.height_min_cm) of a
+# sidecar as fissure writes it (jansson, one key a line), without quotes; prints nothing when missing.
+json_get() {
+    awk -v want="$2" '
+        function key(line) { sub(/^[ \t]*"/, "", line); sub(/".*/, "", line); return line }
+        /^[ \t]*"[^"]*": *\{[ \t]*$/ { path = path "." key($0); next }
+        /^[ \t]*\},?[ \t]*$/ { sub(/\.[^.]*$/, "", path); next }
+        /^[ \t]*"[^"]*": / {
+            v = $0; sub(/^[ \t]*"[^"]*": */, "", v); sub(/,[ \t]*$/, "", v); gsub(/^"|"$/, "", v)
+            if (substr(path "." key($0), 2) == want) { print v; exit }
+        }' "$1"
+}
 finish() {
     if [ "$failures" -eq 0 ]; then exit 0; fi
     printf '%d failure(s)\n' "$failures"; exit 1
