@@ -575,8 +575,11 @@ static int solve(fs_wedge_model *w)
         fs_cg_params p = fs_cg_params_default();
         p.tolerance = w->cfg.solver.tolerance;
         p.max_iterations = w->cfg.solver.max_iterations;
-        if (w->cfg.solver.method == FS_SOLVER_CHOLMOD)
-            scale_guess(w); /* the CG baseline stays the thesis's plain warm start */
+        if (w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
+            /* the CG baseline stays the thesis's: Jacobi, from the previous displacements */
+            scale_guess(w);
+            p.block = 3; /* a node's three unknowns are consecutive (number_dofs) */
+        }
         int it = fs_cg_solve(&w->k_free, w->rhs, w->x, p, NULL);
         if (it < 0)
             rc = -1;

@@ -240,7 +240,8 @@ static int local_solve(fs_wedge_model *w, const int32_t *idx, int32_t m, int32_t
     }
     b_norm = sqrt(b_norm);
     fs_cg_params p = fs_cg_params_default();
-    p.tolerance = b_norm > 0.0 ? fmin(0.1, 0.1 * tol / b_norm) : 0.1;
+    p.tolerance = b_norm > 0.0 ? fmin(0.1, 0.3 * tol / b_norm) : 0.1;
+    p.block = 3; /* a node's three unknowns are consecutive (number_dofs) */
     int rc = fs_cg_solve(&sub, b, delta, p, NULL) < 0 ? -1 : 0;
     if (rc < 0) {
         fs_error_clear();
