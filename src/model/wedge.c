@@ -911,16 +911,30 @@ void fs_wedge_snapshot_take(const fs_wedge_model *w, fs_wedge_snapshot *s)
         free(s->u_fixed);
         s->u_fixed = fs_malloc(((size_t)w->n_fixed + 1) * sizeof *s->u_fixed);
     }
+    if (s->n_nodes != w->n_nodes || !s->node_ratio) {
+        free(s->node_ratio);
+        s->node_ratio = fs_malloc(((size_t)w->n_nodes + 1) * sizeof *s->node_ratio);
+    }
+    if (s->n_elems != w->n_elems || !s->stress_top) {
+        free(s->stress_top);
+        s->stress_top = fs_malloc((18 * (size_t)w->n_elems + 1) * sizeof *s->stress_top);
+    }
     s->n_free = w->n_free;
     s->n_fixed = w->n_fixed;
+    s->n_nodes = w->n_nodes;
+    s->n_elems = w->n_elems;
     memcpy(s->x, w->x, (size_t)w->n_free * sizeof *s->x);
     memcpy(s->u_fixed, w->u_fixed, (size_t)w->n_fixed * sizeof *s->u_fixed);
+    memcpy(s->node_ratio, w->node_ratio, (size_t)w->n_nodes * sizeof *s->node_ratio);
+    memcpy(s->stress_top, w->stress_top, 18 * (size_t)w->n_elems * sizeof *s->stress_top);
 }
 
 void fs_wedge_snapshot_free(fs_wedge_snapshot *s)
 {
     free(s->x);
     free(s->u_fixed);
+    free(s->node_ratio);
+    free(s->stress_top);
     memset(s, 0, sizeof *s);
 }
 

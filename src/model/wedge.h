@@ -191,12 +191,14 @@ typedef struct {
     double time;
     double thickness;            /* the base thickness the system was assembled with */
     double coef[6];              /* shrink_coef then eigenstrain */
-    int32_t n_free, n_fixed;
+    int32_t n_free, n_fixed, n_nodes, n_elems;
     double *x, *u_fixed;
+    double *node_ratio;          /* n_nodes: w->node_ratio (the split criterion's cache) */
+    double *stress_top;          /* 18 per element: w->stress_top */
 } fs_wedge_snapshot;
 
-/* Copies the current state (w->time, w->x, w->u_fixed, the load coefficients) into s, reusing its
- * arrays. */
+/* Copies the current state (w->time, w->x, w->u_fixed, the load coefficients, the top stresses and
+ * the nodal ratio cache) into s, reusing its arrays. */
 void fs_wedge_snapshot_take(const fs_wedge_model *w, fs_wedge_snapshot *s);
 void fs_wedge_snapshot_free(fs_wedge_snapshot *s);
 
@@ -286,8 +288,18 @@ double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e);
 int fs_wedge_split_event(fs_wedge_model *w, int *changed);
 
 /* The largest nodal ratio among the split candidates at the current equilibrium (tips, and nodes off
- * every crack and boundary), -inf if none: what the split method's event search looks at. */
+ * every crack and boundary), -inf if none: what the split method's event search looks at. Fills the
+ * nodal ratio cache of every candidate. */
 double fs_wedge_split_max_ratio(fs_wedge_model *w);
+
+/* fs_wedge_split_max_ratio of the state at time t blended between the snapshots a and b (taken right
+ * after fs_wedge_split_max_ratio on an unchanged mesh, a->time <= t <= b->time), without changing the
+ * model. Exact when it is over 1; otherwise some value at most 1. Only the candidates whose ratio
+ * exceeds 1 in a or b are evaluated: a ratio is convex along the blend (the largest eigenvalue of a
+ * symmetric tensor is a convex function of it, and the stresses blend linearly), so it stays at most
+ * the larger of its ends. */
+double fs_wedge_split_blend_ratio(const fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b,
+                                  double t);
 
 /* Re-factorizes the current matrix now (CHOLMOD; nothing with CG), dropping accumulated updates.
  * Returns 0 or -1 with fs_error. */

@@ -97,6 +97,8 @@ static double exact_ratio(void *ctx, double t)
 static double estimated_ratio(void *ctx, double t)
 {
     search_ctx *c = ctx;
+    if (c->w->cfg.fracture.method == FS_FRACTURE_SPLIT)
+        return fs_wedge_split_blend_ratio(c->w, &c->lo, &c->hi, t);
     if (fs_wedge_interpolate(c->w, &c->lo, &c->hi, t) < 0)
         return NAN;
     return max_ratio(c->w);

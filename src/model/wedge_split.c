@@ -109,11 +109,31 @@ static void from_2d(const frame *f, const double v[2], double out[3])
 
 /* ---- the nodal criterion ---- */
 
-/* Ratio of the top Gauss point of element e nearest corner c, and its principal direction. */
-static double point_ratio(const fs_wedge_model *w, int32_t e, int c, double m[3])
+/* The top stresses the criterion reads: a, or the blend a + s (b - a) when b is not NULL. */
+typedef struct {
+    const double *a, *b;
+    double s;
+} stresses;
+
+/* Voigt stress at top Gauss point c of element e. */
+static void stress_at(const stresses *st, int32_t e, int c, double out[6])
 {
-    double sigma[3], dirs[9];
-    if (fs_eigen_principal_stress(w->stress_top + 18 * (size_t)e + 6 * c, sigma, dirs) < 0) {
+    const double *a = st->a + 18 * (size_t)e + 6 * c;
+    if (!st->b) {
+        memcpy(out, a, 6 * sizeof *out);
+        return;
+    }
+    const double *b = st->b + 18 * (size_t)e + 6 * c;
+    for (int k = 0; k < 6; k++)
+        out[k] = a[k] + st->s * (b[k] - a[k]);
+}
+
+/* Ratio of the top Gauss point of element e nearest corner c, and its principal direction. */
+static double point_ratio(const fs_wedge_model *w, const stresses *st, int32_t e, int c, double m[3])
+{
+    double sigma[3], dirs[9], v[6];
+    stress_at(st, e, c, v);
+    if (fs_eigen_principal_stress(v, sigma, dirs) < 0) {
         fs_error_clear();
         return -INFINITY;
     }
@@ -124,7 +144,7 @@ static double point_ratio(const fs_wedge_model *w, int32_t e, int c, double m[3]
 
 /* Ratio at crack tip i: the largest over its elements of the ratio at the top Gauss point nearest the
  * tip, and that point's principal direction (see the design note). */
-static double tip_ratio(const fs_wedge_model *w, int32_t i, double m[3])
+static double tip_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t i, double m[3])
 {
     double best = -INFINITY;
     for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++) {
@@ -135,7 +155,7 @@ static double tip_ratio(const fs_wedge_model *w, int32_t i, double m[3])
         while (c < 3 && w->mesh->tri[3 * (size_t)e + c] != i)
             c++;
         double d[3];
-        double r = point_ratio(w, e, c, d);
+        double r = point_ratio(w, st, e, c, d);
         if (r > best) {
             best = r;
             if (m)
@@ -148,7 +168,7 @@ static double tip_ratio(const fs_wedge_model *w, int32_t i, double m[3])
 /* Nodal ratio of node i (thesis §5.7.1), and the fracture plane normal (3-D, unit) if m is not NULL.
  * The top Gauss point nearest corner c is top point c (wedge_element.h), whose stress the last
  * equilibrium left in stress_top. -inf for a node without a living element. */
-static double node_ratio(const fs_wedge_model *w, int32_t i, double m[3])
+static double node_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t i, double m[3])
 {
     double s[6] = {0}, thr = 0.0;
     int count = 0;
@@ -159,9 +179,10 @@ static double node_ratio(const fs_wedge_model *w, int32_t i, double m[3])
         int c = 0;
         while (c < 3 && w->mesh->tri[3 * (size_t)e + c] != i)
             c++;
-        const double *st = w->stress_top + 18 * (size_t)e + 6 * c;
+        double v[6];
+        stress_at(st, e, c, v);
         for (int k = 0; k < 6; k++)
-            s[k] += st[k];
+            s[k] += v[k];
         thr += w->threshold[e];
         count++;
     }
@@ -177,6 +198,18 @@ static double node_ratio(const fs_wedge_model *w, int32_t i, double m[3])
     if (m)
         memcpy(m, dirs, 3 * sizeof *m);
     return sigma[0] / (thr / count);
+}
+
+static double tip_ratio(const fs_wedge_model *w, int32_t i, double m[3])
+{
+    const stresses st = {w->stress_top, NULL, 0.0};
+    return tip_ratio_of(w, &st, i, m);
+}
+
+static double node_ratio(const fs_wedge_model *w, int32_t i, double m[3])
+{
+    const stresses st = {w->stress_top, NULL, 0.0};
+    return node_ratio_of(w, &st, i, m);
 }
 
 /* node_ratio without the direction, from the cache w->node_ratio where it is valid. */
@@ -213,6 +246,30 @@ double fs_wedge_split_max_ratio(fs_wedge_model *w)
             best = fmax(best, cached_node_ratio(w, i));
     free(open);
     return best;
+}
+
+double fs_wedge_split_blend_ratio(const fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b,
+                                  double t)
+{
+    FS_ASSERT(a->n_nodes == w->n_nodes && b->n_nodes == w->n_nodes && a->n_elems == w->n_elems &&
+              b->n_elems == w->n_elems);
+    double span = b->time - a->time;
+    const stresses st = {a->stress_top, b->stress_top, span > 0.0 ? (t - a->time) / span : 1.0};
+    double best = -INFINITY, bound = -INFINITY;
+    for (int32_t k = 0; k < w->n_tips; k++)
+        best = fmax(best, tip_ratio_of(w, &st, w->tip_node[k], NULL));
+    uint8_t *open = open_nodes(w);
+    for (int32_t i = 0; i < w->n_nodes; i++) {
+        if (open[i])
+            continue;
+        double end = fmax(a->node_ratio[i], b->node_ratio[i]); /* NaN-free: the cache was filled */
+        if (end > 1.0)
+            best = fmax(best, node_ratio_of(w, &st, i, NULL));
+        else
+            bound = fmax(bound, end);
+    }
+    free(open);
+    return best > 1.0 ? best : fmax(best, bound);
 }
 
 /* ---- tips ---- */
