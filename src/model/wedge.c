@@ -1685,6 +1685,8 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
         rc = update_region(w, nodes, nn);
     if (rc == 0)
         rc = refresh_cache(w, changed, n_changed);
+    if (rc == 0) /* the stresses of the changed elements at the displacements carried over */
+        rc = element_ratios(w, changed, n_changed);
     for (int32_t i = 0; i < w->n_nodes && rc == 0; i++)
         for (int l = 3; l < 6; l++) {
             int32_t g = w->dof[6 * (size_t)i + l];

@@ -40,7 +40,7 @@ fs_config fs_config_default(void)
     c.solver.max_iterations = 0;
     c.solver.relax = FS_RELAX_AUTO;
     c.solver.relax_radius = 4.0;
-    c.solver.relax_tolerance = 1e-2;
+    c.solver.relax_tolerance = 3e-2;
 
     c.wedge.thickness_gradient = 0.0;
     return c;
