@@ -72,6 +72,10 @@ typedef struct {
     double local_seconds;      /* time in fs_wedge_relax, global fallbacks included */
     int64_t time_steps;        /* event searches (advances of time, Algorithm 5) */
     int64_t search_evaluations; /* their exact and estimated evaluations (fracture/event.h) */
+    int64_t event_relaxations; /* returns to equilibrium after a fracture event (fs_wedge_simulate) */
+    double event_relax_seconds; /* their time, local or global */
+    double event_seconds;      /* the events' whole time: the fracture (the cut, the system's update or
+                                  re-factorization) and the relaxation */
 } fs_wedge_counters;
 
 /* The whole state of one layer. Arrays are flat and indexed by mesh node or mesh triangle (one wedge

@@ -131,7 +131,9 @@ int fs_wedge_simulate(fs_wedge_model *w, double t_end)
         while (max_ratio(w) > 1.0) {
             int removed = 0, changed = 1, tips = w->n_tips;
             bool split = w->cfg.fracture.method == FS_FRACTURE_SPLIT;
+            double t_event = fs_seconds();
             rc = split ? fs_wedge_split_event(w, &changed) : fs_wedge_fracture(w, &removed);
+            w->counters.event_seconds += fs_seconds() - t_event;
             if (rc < 0)
                 goto done;
             if (rc == 1)
@@ -142,7 +144,12 @@ int fs_wedge_simulate(fs_wedge_model *w, double t_end)
                 continue;  /* a tip was retired: the next candidate */
             }
             bool local = (removed || split) && w->cfg.solver.relax == FS_RELAX_LOCAL;
-            if ((rc = local ? fs_wedge_relax(w, NULL, 0) : fs_wedge_equilibrium(w, w->time)) < 0)
+            double t0 = fs_seconds();
+            rc = local ? fs_wedge_relax(w, NULL, 0) : fs_wedge_equilibrium(w, w->time);
+            w->counters.event_relaxations++;
+            w->counters.event_relax_seconds += fs_seconds() - t0;
+            w->counters.event_seconds += fs_seconds() - t0;
+            if (rc < 0)
                 goto done;
             report(w, t_end);
         }
@@ -191,9 +198,11 @@ int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, f
         fs_debug("wedge: %lld splits, %lld tips retired by Griffith, %d tips left; relaxations %lld local, "
                  "%lld global", (long long)w.fractures, (long long)w.griffith_stops, (int)w.n_tips,
                  (long long)w.counters.local_relaxations, (long long)w.counters.global_fallbacks);
-        fs_debug("wedge: %lld time steps, %lld event-search evaluations; local relaxation %.2f s, %lld unknowns, "
-                 "%lld retries", (long long)c->time_steps, (long long)c->search_evaluations, c->local_seconds,
-                 (long long)c->local_dofs, (long long)c->relax_retries);
+        double per = c->event_relaxations ? 1e3 / (double)c->event_relaxations : 0.0;
+        fs_debug("wedge: %lld time steps, %lld event-search evaluations; %lld events with relaxation, %.2f ms each "
+                 "(%.2f ms relaxing); local relaxation %.2f s, %lld unknowns, %lld retries", (long long)c->time_steps,
+                 (long long)c->search_evaluations, (long long)c->event_relaxations, per * c->event_seconds,
+                 per * c->event_relax_seconds, c->local_seconds, (long long)c->local_dofs, (long long)c->relax_retries);
         fs_debug("wedge: %lld removals, %lld subdivisions, %lld solves (%.2f s), %lld factorizations (%.2f s), "
                  "%lld analyses (%.2f s), %lld updates (%.2f s), assembly %.2f s, stresses %.2f s, "
                  "%lld CG iterations",
