@@ -319,7 +319,7 @@ int fs_wedge_simulate(fs_wedge_model *w, double t_end);
  * removed, split or its nodes duplicated, a node moved) only the nodes near the change move much.
  * The residual f - K u of the current displacements marks the free nodes out of balance (plus the
  * changed nodes given); the marked set grows to every node within the relaxation radius, measured as
- * the shortest path along the top edges of living elements, so cracks (removed elements, duplicated
+ * the shortest path along the edges of living elements (at rest), so cracks (removed elements, duplicated
  * nodes) are barriers; the marked unknowns are solved with all others held (conjugate gradients on
  * the principal submatrix). If the residual then meets the tolerance, the radius shrinks for the next
  * event (x 0.75, not below one mean edge length); else the attempt is repeated at twice the radius,
@@ -344,7 +344,7 @@ int fs_wedge_simulate(fs_wedge_model *w, double t_end);
 int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n);
 
 /* The nodes fs_wedge_relax relaxes around the seed nodes (n mesh nodes) at the given radius (cm): every
- * node joined to a seed by a path along the top edges of living elements no longer than radius, the
+ * node joined to a seed by a path along the edges of living elements (at rest) no longer than radius, the
  * seeds first (each once). out has room for w->n_nodes entries; returns the count. */
 int32_t fs_wedge_relax_region(const fs_wedge_model *w, const int32_t *seeds, int32_t n, double radius, int32_t *out);
 

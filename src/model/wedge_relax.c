@@ -122,7 +122,16 @@ static double norm_max(const double *v, int32_t n)
 
 /* ---- marking ---- */
 
-/* Mean edge length of the living elements' top faces (cm): the unit of the relaxation radius. */
+/* Length of the edge from corner a to corner b of element e in the surface mesh at rest (cm). */
+static double edge_length(const fs_mesh *m, int32_t e, int a, int b)
+{
+    double p[3], q[3];
+    fs_mesh_corner(m, e, a, p);
+    fs_mesh_corner(m, e, b, q);
+    return sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+}
+
+/* Mean edge length of the living elements at rest (cm): the unit of the relaxation radius. */
 static double mean_edge(const fs_wedge_model *w)
 {
     double sum = 0.0;
@@ -130,20 +139,16 @@ static double mean_edge(const fs_wedge_model *w)
     for (int32_t e = 0; e < w->n_elems; e++) {
         if (w->state[e] != FS_WEDGE_ALIVE)
             continue;
-        double x[18];
-        fs_wedge_element_coords(w, e, x);
-        for (int c = 0; c < 3; c++) {
-            const double *a = x + 9 + 3 * c, *b = x + 9 + 3 * ((c + 1) % 3);
-            sum += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-            count++;
-        }
+        for (int c = 0; c < 3; c++)
+            sum += edge_length(w->mesh, e, c, (c + 1) % 3);
+        count += 3;
     }
     return count ? sum / (double)count : 1.0;
 }
 
-/* Dijkstra from the seed nodes (dist 0) along the top edges of living elements, up to radius: every
- * node reached gets its distance in dist (INFINITY elsewhere) and is appended to out, which receives
- * the seeds first. Returns the number of nodes in out. */
+/* Dijkstra from the seed nodes (dist 0) along the edges of living elements at rest, up to radius:
+ * every node reached gets its distance in dist (INFINITY elsewhere) and is appended to out, which
+ * receives the seeds first. Returns the number of nodes in out. */
 static int32_t grow_region(const fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds, double radius,
                            double *dist, int32_t *out)
 {
@@ -168,17 +173,11 @@ static int32_t grow_region(const fs_wedge_model *w, const int32_t *seeds, int32_
             while (ci < 3 && tri[ci] != i)
                 ci++;
             FS_ASSERT(ci < 3);
-            double x[18];
-            fs_wedge_element_coords(w, e, x);
-            const double *a = x + 9 + 3 * ci;
             for (int c = 0; c < 3; c++) {
                 int32_t j = tri[c];
                 if (j == i)
                     continue;
-                const double *b = x + 9 + 3 * c;
-                double len = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                                  (a[2] - b[2]) * (a[2] - b[2]));
-                double d = it.d + len;
+                double d = it.d + edge_length(w->mesh, e, ci, c);
                 if (d <= radius && d < dist[j]) {
                     if (dist[j] == INFINITY)
                         out[n_out++] = j;
@@ -215,6 +214,29 @@ static int cmp_int32(const void *a, const void *b)
 {
     int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
     return (x > y) - (x < y);
+}
+
+/* Sorts v (n values in 0 .. range - 1) ascending without repeats; returns the new count. A large list
+ * is sorted by marking and scanning its range, a short one by comparisons. */
+static int32_t sort_unique(int32_t *v, int32_t n, int32_t range)
+{
+    if ((int64_t)n * 16 < range) {
+        qsort(v, (size_t)n, sizeof *v, cmp_int32);
+        int32_t m = 0;
+        for (int32_t q = 0; q < n; q++)
+            if (m == 0 || v[m - 1] != v[q])
+                v[m++] = v[q];
+        return m;
+    }
+    uint8_t *seen = fs_calloc((size_t)range + 1, 1);
+    for (int32_t q = 0; q < n; q++)
+        seen[v[q]] = 1;
+    int32_t m = 0;
+    for (int32_t i = 0; i < range; i++)
+        if (seen[i])
+            v[m++] = i;
+    free(seen);
+    return m;
 }
 
 /* ---- the local solve ---- */
@@ -318,11 +340,7 @@ static int local_stresses(fs_wedge_model *w, const int32_t *nodes, int32_t n_nod
         for (int32_t p = w->node_elem_start[nodes[a]]; p < w->node_elem_start[nodes[a]] + w->node_elem_count[nodes[a]]; p++)
             if (w->state[w->node_elem[p]] == FS_WEDGE_ALIVE)
                 elems[ne++] = w->node_elem[p];
-    qsort(elems, (size_t)ne, sizeof *elems, cmp_int32);
-    int32_t unique = 0;
-    for (int32_t q = 0; q < ne; q++)
-        if (unique == 0 || elems[unique - 1] != elems[q])
-            elems[unique++] = elems[q];
+    int32_t unique = sort_unique(elems, ne, w->n_elems);
     int rc = fs_wedge_update_ratios(w, elems, unique);
     free(elems);
     return rc;
@@ -355,7 +373,7 @@ static int attempt(fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds, dou
                 idx[m++] = g;
         }
     }
-    qsort(idx, (size_t)m, sizeof *idx, cmp_int32);
+    m = sort_unique(idx, m, nf);
     w->counters.local_dofs += m;
     double *delta = fs_malloc(((size_t)m + 1) * sizeof *delta);
     int ok = m > 0 && local_solve(w, idx, m, map, r, delta, tol) == 0;
