@@ -874,6 +874,7 @@ static void scatter_u(fs_wedge_model *w)
 
 int fs_wedge_equilibrium(fs_wedge_model *w, double t)
 {
+    w->residual_valid = false;
     double h = layer_thickness(w, t);
     if (h != w->assembled_thickness && refill_system(w, h) < 0)
         return -1;
@@ -943,6 +944,7 @@ int fs_wedge_interpolate(fs_wedge_model *w, const fs_wedge_snapshot *a, const fs
     FS_ASSERT(a->n_free == w->n_free && b->n_free == w->n_free && a->n_fixed == w->n_fixed &&
               b->n_fixed == w->n_fixed);
     double span = b->time - a->time, s = span > 0.0 ? (t - a->time) / span : 1.0;
+    w->residual_valid = false;
     for (int k = 0; k < 3; k++) {
         w->shrink_coef[k] = a->coef[k] + s * (b->coef[k] - a->coef[k]);
         w->eigenstrain[k] = a->coef[3 + k] + s * (b->coef[3 + k] - a->coef[3 + k]);
@@ -1118,6 +1120,7 @@ int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg)
 
 int fs_wedge_pin_top(fs_wedge_model *w, const uint8_t *pinned)
 {
+    w->residual_valid = false; /* see fs_wedge_relax */
     for (int32_t i = 0; i < w->n_nodes; i++)
         w->pinned[i] = pinned[i] != 0;
     return build_system(w);
@@ -1136,6 +1139,8 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->ratio);
     free(w->stress_top);
     free(w->node_ratio);
+    free(w->residual);
+    free(w->dirty_nodes);
     free(w->gauss_cache);
     free(w->ratio_lipschitz);
     free(w->ratio_ref_bound);
@@ -1328,6 +1333,7 @@ static int update_factor_after_removal(fs_wedge_model *w, const double K[324], c
 
 int fs_wedge_remove(fs_wedge_model *w, int32_t e)
 {
+    w->residual_valid = false; /* see fs_wedge_relax */
     FS_ASSERT(e >= 0 && e < w->n_elems && w->state[e] == FS_WEDGE_ALIVE);
     double K[324], loads[FS_WEDGE_PATTERNS][18];
     if (element_system(w, e, w->assembled_thickness, K, loads) < 0)
@@ -1554,6 +1560,7 @@ static int32_t descendants(const fs_refine_change *ch, const int32_t *list, int3
 
 int fs_wedge_subdivide(fs_wedge_model *w, const int32_t *elems, int32_t n, bool to_min_size, int32_t *bisected)
 {
+    w->residual_valid = false; /* see fs_wedge_relax */
     double t0 = fs_seconds();
     *bisected = 0;
     int32_t n_tris0 = w->n_elems, n_free_old = w->n_free, n_fixed_old = w->n_fixed;
@@ -1683,6 +1690,12 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
     int rc = extend_system(w, n_free_old, n_fixed_old, changed, n_changed);
     if (rc == 0)
         rc = update_region(w, nodes, nn);
+    if (w->n_dirty + nn > w->cap_dirty) { /* their rows of f - K u changed (wedge_relax.c) */
+        w->cap_dirty = 2 * (w->n_dirty + nn);
+        w->dirty_nodes = fs_realloc(w->dirty_nodes, (size_t)w->cap_dirty * sizeof *w->dirty_nodes);
+    }
+    memcpy(w->dirty_nodes + w->n_dirty, nodes, (size_t)nn * sizeof *nodes);
+    w->n_dirty += nn;
     if (rc == 0)
         rc = refresh_cache(w, changed, n_changed);
     if (rc == 0) /* the stresses of the changed elements at the displacements carried over */

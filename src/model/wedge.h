@@ -154,6 +154,13 @@ typedef struct {
                                     fs_wedge_relax call: the unit of cfg.solver.relax_radius and the
                                     smallest radius (one ring); 0 before that call */
     double relax_radius;         /* local relaxation radius (cm), adapted by fs_wedge_relax */
+    double *residual;            /* residual_n: f - K u after the last local relaxation (wedge_relax.c) */
+    int32_t residual_n;
+    bool residual_valid;         /* residual still describes the model but for the rows of dirty_nodes;
+                                    cleared by everything that moves the model except a cut */
+    double residual_tau;         /* the acceptance bound it was computed with */
+    int32_t *dirty_nodes;        /* nodes whose rows a cut changed since the last local relaxation */
+    int32_t n_dirty, cap_dirty;
 
     int64_t fractures;           /* elements removed so far, or node splits (fracture.method = split) */
     fs_wedge_counters counters;

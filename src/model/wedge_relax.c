@@ -14,6 +14,12 @@
 #define RADIUS_GROW 2.0
 #define RADIUS_SHRINK 0.75
 
+/* A list of node indices with room decided by the caller. */
+typedef struct {
+    int32_t *v;
+    int32_t n;
+} ilist_t;
+
 /* ---- a binary min-heap of (distance, node), ties by node index ---- */
 
 typedef struct {
@@ -486,6 +492,64 @@ static int relax_region(fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds
     return rc;
 }
 
+/* One entry of f - K u: the residual of free unknown g, of node `node`, from the loads at the current
+ * coefficients and the stiffness couplings with every unknown of the nodes sharing a living element
+ * with it (the only nonzero ones), free (w->x) and fixed (w->u_fixed). nb is scratch for the neighbour
+ * list, flag (per node) is 0 on entry and on return. */
+static double row_residual(const fs_wedge_model *w, int32_t g, int32_t node, ilist_t *nb, uint8_t *flag)
+{
+    int32_t nf = w->n_free;
+    const double coef[FS_WEDGE_PATTERNS] = {w->shrink_coef[0], w->shrink_coef[1], w->shrink_coef[2],
+                                            w->eigenstrain[0], w->eigenstrain[1], w->eigenstrain[2]};
+    double s = 0.0;
+    for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
+        s += coef[q] * w->load[(size_t)q * nf + g];
+    nb->n = 0;
+    for (int32_t p = w->node_elem_start[node]; p < w->node_elem_start[node] + w->node_elem_count[node]; p++) {
+        int32_t e = w->node_elem[p];
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        for (int c = 0; c < 3; c++) {
+            int32_t b = w->mesh->tri[3 * (size_t)e + c];
+            if (!flag[b]) {
+                flag[b] = 1;
+                nb->v[nb->n++] = b;
+            }
+        }
+    }
+    const fs_sparse_matrix *k = &w->k_all;
+    for (int32_t q = 0; q < nb->n; q++) {
+        int32_t b = nb->v[q];
+        flag[b] = 0;
+        for (int l = 0; l < 6; l++) {
+            int32_t j = w->dof[6 * (size_t)b + l];
+            double v = j < nf ? w->x[j] : w->u_fixed[j - nf];
+            if (v == 0.0)
+                continue;
+            int32_t col = j > g ? j : g, row = j > g ? g : j;
+            int32_t lo = k->col_ptr[col], hi = k->col_ptr[col + 1];
+            while (lo < hi) { /* rows ascending within a column */
+                int32_t mid = lo + (hi - lo) / 2;
+                if (k->row_idx[mid] < row)
+                    lo = mid + 1;
+                else
+                    hi = mid;
+            }
+            if (lo < k->col_ptr[col + 1] && k->row_idx[lo] == row)
+                s -= k->values[lo] * v;
+        }
+    }
+    return s;
+}
+
+/* design: the residual is kept between events. After an accepted local relaxation every entry of
+ * f - K u is within the bound; a cut (fs_wedge_apply_change) changes the couplings and loads of the
+ * nodes of the elements it changed only (w->dirty_nodes), whose rows are recomputed one by one; new
+ * free unknowns come last, so the old ones keep their index. So an event costs what its region costs,
+ * not a pass over the whole matrix. The bound keeps the load norm of the last full computation (a
+ * cut changes it by the loads of a few elements). Anything else that moves the model (a global solve,
+ * a new time, a removal or subdivision) makes the kept residual invalid, and the next call computes
+ * it in full. */
 int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n)
 {
     double t0 = fs_seconds();
@@ -501,11 +565,6 @@ int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n)
             if (g < nf)
                 w->x[g] = w->u[6 * (size_t)i + l];
         }
-    double *r = fs_malloc(((size_t)nf + 1) * sizeof *r);
-    double b_norm = residual(w, r);
-    double tau = nf > 0 ? w->cfg.solver.relax_tolerance * b_norm / sqrt((double)nf) : 0.0;
-
-    /* 1. seeds: the changed nodes and the nodes with a free DOF out of balance */
     double *dist = fs_malloc(((size_t)nn + 1) * sizeof *dist);
     uint8_t *flag = fs_calloc((size_t)nn + 1, 1);
     int32_t *seeds = fs_malloc(((size_t)nn + 1) * sizeof *seeds), n_seeds = 0;
@@ -516,29 +575,77 @@ int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n)
             flag[changed_nodes[q]] = 1;
             seeds[n_seeds++] = changed_nodes[q];
         }
-    for (int32_t i = 0; i < nn; i++) {
-        if (flag[i])
-            continue;
-        for (int l = 3; l < 6; l++) {
-            int32_t g = w->dof[6 * (size_t)i + l];
-            if (g < nf && fabs(r[g]) > tau) {
+
+    /* 1. the residual, and as seeds the nodes with a free DOF out of balance */
+    double *r, tau;
+    if (w->residual_valid && w->residual_n <= nf) {
+        r = fs_realloc(w->residual, ((size_t)nf + 1) * sizeof *r);
+        w->residual = NULL;
+        tau = w->residual_tau;
+        int32_t cap = 0;
+        for (int32_t i = 0; i < nn; i++)
+            cap = w->node_elem_count[i] > cap ? w->node_elem_count[i] : cap;
+        ilist_t nb = {fs_malloc((3 * (size_t)cap + 1) * sizeof *nb.v), 0};
+        uint8_t *seen = fs_calloc((size_t)nn + 1, 1);
+        /* new nodes come last, and so do their unknowns: all of them are recomputed */
+        int32_t first_new = nn;
+        while (first_new > 0 && w->dof[6 * (size_t)(first_new - 1) + 3] >= w->residual_n)
+            first_new--;
+        for (int32_t q = 0; q < w->n_dirty + (nn - first_new); q++) {
+            int32_t i = q < w->n_dirty ? w->dirty_nodes[q] : first_new + (q - w->n_dirty);
+            bool out = false;
+            for (int l = 3; l < 6; l++) {
+                int32_t g = w->dof[6 * (size_t)i + l];
+                if (g < nf) {
+                    r[g] = row_residual(w, g, i, &nb, seen);
+                    out |= fabs(r[g]) > tau;
+                }
+            }
+            if (out && !flag[i]) {
                 flag[i] = 1;
                 seeds[n_seeds++] = i;
-                break;
+            }
+        }
+        free(seen);
+        free(nb.v);
+    } else {
+        r = fs_malloc(((size_t)nf + 1) * sizeof *r);
+        double b_norm = residual(w, r);
+        tau = nf > 0 ? w->cfg.solver.relax_tolerance * b_norm / sqrt((double)nf) : 0.0;
+        for (int32_t i = 0; i < nn; i++) {
+            if (flag[i])
+                continue;
+            for (int l = 3; l < 6; l++) {
+                int32_t g = w->dof[6 * (size_t)i + l];
+                if (g < nf && fabs(r[g]) > tau) {
+                    flag[i] = 1;
+                    seeds[n_seeds++] = i;
+                    break;
+                }
             }
         }
     }
+    w->n_dirty = 0;
     for (int32_t q = 0; q < n_seeds; q++)
         flag[seeds[q]] = 0;
     int rc = 0;
+    w->residual_valid = true; /* unless the relaxation falls back on a global solve */
     if (n_seeds == 0)
         w->counters.local_relaxations++; /* in balance already */
     else
         rc = relax_region(w, seeds, n_seeds, r, tau, dist, flag);
+    if (rc == 0 && w->residual_valid) {
+        free(w->residual);
+        w->residual = r;
+        w->residual_n = nf;
+        w->residual_tau = tau;
+    } else {
+        w->residual_valid = false;
+        free(r);
+    }
     free(seeds);
     free(flag);
     free(dist);
-    free(r);
     w->counters.local_seconds += fs_seconds() - t0;
     return rc;
 }
