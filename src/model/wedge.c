@@ -515,11 +515,11 @@ static void fixed_displacements(fs_wedge_model *w, double t)
     }
 }
 
-static void build_rhs(fs_wedge_model *w)
+void fs_wedge_build_rhs(fs_wedge_model *w)
 {
     int32_t nf = w->n_free;
-    double coef[FS_WEDGE_PATTERNS] = {w->shrink_coef[0], w->shrink_coef[1], w->shrink_coef[2],
-                                      w->eigenstrain[0], w->eigenstrain[1], w->eigenstrain[2]};
+    double coef[FS_WEDGE_PATTERNS];
+    fs_wedge_load_coefficients(w, coef);
     for (int32_t i = 0; i < nf; i++) {
         double s = 0.0;
         for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
@@ -791,8 +791,8 @@ static int element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_ele
 {
     double t0 = fs_seconds();
     int32_t n_over = 0;
-    double coef[FS_WEDGE_PATTERNS] = {w->shrink_coef[0], w->shrink_coef[1], w->shrink_coef[2],
-                                      w->eigenstrain[0], w->eigenstrain[1], w->eigenstrain[2]};
+    double coef[FS_WEDGE_PATTERNS];
+    fs_wedge_load_coefficients(w, coef);
     if (memcmp(coef, w->ratio_ref_coef, sizeof coef) != 0) {
         for (int32_t e = 0; e < w->n_elems; e++)
             w->ratio_ref_bound[e] = NAN;
@@ -890,7 +890,7 @@ int fs_wedge_equilibrium(fs_wedge_model *w, double t)
             w->eigenstrain[k] = -v[k];
     }
     fixed_displacements(w, t);
-    build_rhs(w);
+    fs_wedge_build_rhs(w);
     if ((w->factor_stale && w->cfg.solver.relax != FS_RELAX_LOCAL && factorize(w, false) < 0) || solve(w) < 0)
         return -1;
     scatter_u(w);
@@ -1726,8 +1726,8 @@ double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e)
     fs_wedge_element_coords(w, e, x);
     patterns(x, pat);
     gather_u(w, e, ue);
-    double coef[FS_WEDGE_PATTERNS] = {w->shrink_coef[0], w->shrink_coef[1], w->shrink_coef[2],
-                                      w->eigenstrain[0], w->eigenstrain[1], w->eigenstrain[2]};
+    double coef[FS_WEDGE_PATTERNS];
+    fs_wedge_load_coefficients(w, coef);
     for (int a = 0; a < 18; a++)
         for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
             ue[a] -= coef[q] * pat[q][a];

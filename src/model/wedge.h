@@ -196,6 +196,19 @@ int fs_wedge_pin_top(fs_wedge_model *w, const uint8_t *pinned);
  * element degenerates. */
 int fs_wedge_equilibrium(fs_wedge_model *w, double t);
 
+/* The current coefficients of the unit loads w->load: shrinkage (shrink_coef), then growth
+ * eigenstrain. */
+static inline void fs_wedge_load_coefficients(const fs_wedge_model *w, double coef[FS_WEDGE_PATTERNS])
+{
+    for (int k = 0; k < 3; k++) {
+        coef[k] = w->shrink_coef[k];
+        coef[3 + k] = w->eigenstrain[k];
+    }
+}
+
+/* w->rhs = the loads at the current coefficients net of the fixed DOFs' motion, f - K_fb u_b. */
+void fs_wedge_build_rhs(fs_wedge_model *w);
+
 /* An equilibrium state of the model at one time, on an unchanged mesh: what fs_wedge_interpolate
  * blends. Owns its arrays; release with fs_wedge_snapshot_free. */
 typedef struct {

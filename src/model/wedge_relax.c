@@ -74,44 +74,14 @@ static heap_item heap_pop(heap *h)
 
 /* ---- residual ---- */
 
-/* w->rhs = f - K_fb u_b (the loads at the current coefficients net of the fixed DOFs' motion) and
- * r = rhs - K_ff x, both over the free DOFs, in one pass over k_all in column order. Returns ||rhs||. */
+/* w->rhs = f - K_fb u_b (fs_wedge_build_rhs) and r = rhs - K_ff x over the free DOFs. Returns
+ * ||rhs||. */
 static double residual(fs_wedge_model *w, double *r)
 {
-    int32_t nf = w->n_free;
-    double coef[FS_WEDGE_PATTERNS] = {w->shrink_coef[0], w->shrink_coef[1], w->shrink_coef[2],
-                                      w->eigenstrain[0], w->eigenstrain[1], w->eigenstrain[2]};
-    for (int32_t i = 0; i < nf; i++) {
-        double s = 0.0;
-        for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
-            s += coef[q] * w->load[(size_t)q * nf + i];
-        w->rhs[i] = s;
-        r[i] = 0.0;
-    }
-    const fs_sparse_matrix *k = &w->k_all;
-    for (int32_t j = 0; j < nf; j++) {
-        double xj = w->x[j], kx = 0.0;
-        for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++) {
-            int32_t i = k->row_idx[p];
-            double v = k->values[p];
-            if (i == j) {
-                kx += v * xj;
-            } else {
-                r[i] += v * xj;
-                kx += v * w->x[i];
-            }
-        }
-        r[j] += kx;
-    }
-    for (int32_t j = nf; j < nf + w->n_fixed; j++) {
-        double uj = w->u_fixed[j - nf];
-        if (uj == 0.0)
-            continue;
-        for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++)
-            w->rhs[k->row_idx[p]] -= k->values[p] * uj;
-    }
+    fs_wedge_build_rhs(w);
+    fs_sparse_matvec(&w->k_free, w->x, r);
     double b2 = 0.0;
-    for (int32_t i = 0; i < nf; i++) {
+    for (int32_t i = 0; i < w->n_free; i++) {
         r[i] = w->rhs[i] - r[i];
         b2 += w->rhs[i] * w->rhs[i];
     }
@@ -499,8 +469,8 @@ static int relax_region(fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds
 static double row_residual(const fs_wedge_model *w, int32_t g, int32_t node, ilist_t *nb, uint8_t *flag)
 {
     int32_t nf = w->n_free;
-    const double coef[FS_WEDGE_PATTERNS] = {w->shrink_coef[0], w->shrink_coef[1], w->shrink_coef[2],
-                                            w->eigenstrain[0], w->eigenstrain[1], w->eigenstrain[2]};
+    double coef[FS_WEDGE_PATTERNS];
+    fs_wedge_load_coefficients(w, coef);
     double s = 0.0;
     for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
         s += coef[q] * w->load[(size_t)q * nf + g];

@@ -109,6 +109,15 @@ static void from_2d(const frame *f, const double v[2], double out[3])
 
 /* ---- the nodal criterion ---- */
 
+/* The corner of triangle t at node, or -1. */
+static int corner_of(const fs_mesh *m, int32_t t, int32_t node)
+{
+    for (int c = 0; c < 3; c++)
+        if (m->tri[3 * (size_t)t + c] == node)
+            return c;
+    return -1;
+}
+
 /* The top stresses the criterion reads: a, or the blend a + s (b - a) when b is not NULL. */
 typedef struct {
     const double *a, *b;
@@ -151,9 +160,7 @@ static double tip_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t 
         int32_t e = w->node_elem[p];
         if (w->state[e] != FS_WEDGE_ALIVE)
             continue;
-        int c = 0;
-        while (c < 3 && w->mesh->tri[3 * (size_t)e + c] != i)
-            c++;
+        int c = corner_of(w->mesh, e, i);
         double d[3];
         double r = point_ratio(w, st, e, c, d);
         if (r > best) {
@@ -176,9 +183,7 @@ static double node_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t
         int32_t e = w->node_elem[p];
         if (w->state[e] != FS_WEDGE_ALIVE)
             continue;
-        int c = 0;
-        while (c < 3 && w->mesh->tri[3 * (size_t)e + c] != i)
-            c++;
+        int c = corner_of(w->mesh, e, i);
         double v[6];
         stress_at(st, e, c, v);
         for (int k = 0; k < 6; k++)
@@ -422,14 +427,6 @@ static void set_corner(fs_mesh *m, int32_t t, int c, int32_t i, const double p[3
     double ex = fs_domain_extent_x(&m->domain), ey = fs_domain_extent_y(&m->domain);
     m->shift[6 * (size_t)t + 2 * c] = (int8_t)lround((p[0] - q[0]) / ex);
     m->shift[6 * (size_t)t + 2 * c + 1] = (int8_t)lround((p[1] - q[1]) / ey);
-}
-
-static int corner_of(const fs_mesh *m, int32_t t, int32_t node)
-{
-    for (int c = 0; c < 3; c++)
-        if (m->tri[3 * (size_t)t + c] == node)
-            return c;
-    return -1;
 }
 
 /* Living triangles that have node i as a corner, ascending (a scan: the cut changes the mesh under
