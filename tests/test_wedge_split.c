@@ -259,6 +259,71 @@ static void test_single_split(void)
     fs_mesh_free(&m);
 }
 
+/* Entry (row, col) of an upper CSC matrix (0 when not stored). */
+static double csc_entry(const fs_sparse_matrix *k, int32_t row, int32_t col)
+{
+    for (int32_t p = k->col_ptr[col]; p < k->col_ptr[col + 1]; p++)
+        if (k->row_idx[p] == row)
+            return k->values[p];
+    return 0.0;
+}
+
+/* The stiffness matrix the cuts extended in place (fs_wedge_apply_change) is well formed (rows
+ * strictly ascending in every column, which ends on its diagonal) and equals a fresh assembly of the
+ * cut mesh: every entry of the fresh one with the same value, every other stored entry zero; with
+ * growth that moves the fixed bottom nodes, so the fixed columns are exercised too. */
+static void test_extended_matrix_is_fresh(void)
+{
+    fs_config cfg = strip_config();
+    cfg.domain.periodic_x = cfg.domain.periodic_y = false;
+    fs_mesh m = {0};
+    CHECK(make_mesh(&cfg, 600, &m) == 0);
+    fs_wedge_model w;
+    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_simulate(&w, 1.0) == 0);
+    CHECK_MSG(w.fractures >= 10, "%lld splits", (long long)w.fractures);
+    fs_sparse_matrix *k = &w.k_all;
+    int32_t order = k->n, bad = 0;
+    for (int32_t j = 0; j < order; j++) {
+        for (int32_t p = k->col_ptr[j]; p + 1 < k->col_ptr[j + 1]; p++)
+            bad += k->row_idx[p] >= k->row_idx[p + 1];
+        bad += k->col_ptr[j + 1] == k->col_ptr[j] || k->row_idx[k->col_ptr[j + 1] - 1] != j;
+    }
+    CHECK_MSG(bad == 0, "%d malformed columns", (int)bad);
+    fs_sparse_matrix old = {order, malloc(((size_t)order + 1) * sizeof(int32_t)), NULL, NULL};
+    int32_t nnz = k->col_ptr[order];
+    old.row_idx = malloc((size_t)nnz * sizeof(int32_t));
+    old.values = malloc((size_t)nnz * sizeof(double));
+    memcpy(old.col_ptr, k->col_ptr, ((size_t)order + 1) * sizeof(int32_t));
+    memcpy(old.row_idx, k->row_idx, (size_t)nnz * sizeof(int32_t));
+    memcpy(old.values, k->values, (size_t)nnz * sizeof(double));
+    uint8_t *none = calloc((size_t)w.n_nodes + 1, 1);
+    CHECK(fs_wedge_pin_top(&w, none) == 0); /* the same numbering, assembled afresh */
+    free(none);
+    CHECK(k->n == order);
+    double scale = 0.0, worst = 0.0;
+    for (int32_t p = 0; p < nnz; p++)
+        scale = fmax(scale, fabs(old.values[p]));
+    int32_t missing = 0;
+    for (int32_t j = 0; j < order && k->n == order; j++) {
+        for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++) {
+            int32_t i = k->row_idx[p];
+            bool stored = false;
+            for (int32_t q = old.col_ptr[j]; q < old.col_ptr[j + 1]; q++)
+                stored |= old.row_idx[q] == i;
+            missing += !stored && k->values[p] != 0.0;
+            worst = fmax(worst, fabs(k->values[p] - csc_entry(&old, i, j)));
+        }
+        for (int32_t q = old.col_ptr[j]; q < old.col_ptr[j + 1]; q++)
+            worst = fmax(worst, fabs(old.values[q] - csc_entry(k, old.row_idx[q], j)));
+    }
+    CHECK_MSG(missing == 0, "%d fresh entries missing from the extended matrix", (int)missing);
+    CHECK_MSG(worst <= 1e-12 * scale, "extended and fresh matrices differ by %.3g of %.3g", worst, scale);
+    fs_sparse_matrix_free(&old);
+    fs_wedge_free(&w);
+    fs_mesh_free(&m);
+}
+
 /* Griffith: a high toughness stops the crack after its first extension, a zero one does not. */
 static void test_griffith(void)
 {
@@ -289,5 +354,6 @@ int main(void)
     RUN(test_single_split);
     RUN(test_crack_perpendicular);
     RUN(test_griffith);
+    RUN(test_extended_matrix_is_fresh);
     return check_finish();
 }

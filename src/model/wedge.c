@@ -1403,18 +1403,25 @@ static int32_t old_column(int32_t j, int32_t n_free_old, int32_t n_fixed_old, in
 }
 
 /* design: the matrix is extended in place. The new pattern is the old one plus the (sorted, possibly
- * repeated, possibly present) pairs of the changed elements and the diagonals of the new DOFs. Old rows
- * keep their indices (a column holds rows no larger than itself among the free DOFs, and fixed columns
- * hold free rows only), so every old column moves as a block to a position no lower than before: one
- * counting pass fixes the new column starts, then the columns are moved from the last to the first,
- * unchanged runs by memmove and columns with new pairs by a merge from the back, which never
- * overwrites an entry not yet read. The arrays grow geometrically, so a cut costs one pass over the
- * entries behind its first changed column and no allocation. New entries are 0 (update_region adds the
- * contributions). */
+ * repeated, possibly present) pairs of the changed elements and the diagonals of the new DOFs. Old free
+ * rows keep their indices (a free column holds rows no larger than itself; a fixed column holds free
+ * rows and its own zero diagonal, whose index moves up with the column, see new_row), so every old
+ * column moves as a block to a position no lower than before: one counting pass fixes the new column
+ * starts, then the columns are moved from the last to the first, unchanged runs by memmove and columns
+ * with new pairs by a merge from the back, which never overwrites an entry not yet read. The arrays
+ * grow geometrically, so a cut costs one pass over the entries behind its first changed column and no
+ * allocation. New entries are 0 (update_region adds the contributions). */
+
+/* The new index of old row r (a fixed index moves up by the number of new free DOFs). */
+static inline int64_t new_row(int32_t r, int32_t n_free_old, int32_t shift)
+{
+    return r < n_free_old ? r : (int64_t)r + shift;
+}
+
 static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_old, const int32_t *elems,
                          int32_t n_changed)
 {
-    int32_t nf = w->n_free, order = w->n_free + w->n_fixed;
+    int32_t nf = w->n_free, order = w->n_free + w->n_fixed, shift = nf - n_free_old;
     size_t cap = 0, np = 0;
     int64_t *pairs = NULL;
     for (int32_t q = 0; q < n_changed; q++) {
@@ -1452,7 +1459,7 @@ static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_
             continue;
         }
         while (po < po_end || (pp < np && pairs[pp] / order == j)) {
-            int64_t r_old = po < po_end ? k->row_idx[po] : INT64_MAX;
+            int64_t r_old = po < po_end ? new_row(k->row_idx[po], n_free_old, shift) : INT64_MAX;
             int64_t r_new = pp < np && pairs[pp] / order == j ? pairs[pp] % order : INT64_MAX;
             int64_t r = r_old < r_new ? r_old : r_new;
             po += r_old == r;
@@ -1487,13 +1494,16 @@ static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_
             size_t len = (size_t)(k->col_ptr[jo + 1] - k->col_ptr[jo2]);
             memmove(k->row_idx + ptr[j2], k->row_idx + k->col_ptr[jo2], len * sizeof *k->row_idx);
             memmove(k->values + ptr[j2], k->values + k->col_ptr[jo2], len * sizeof *k->values);
+            if (j2 >= nf && shift > 0) /* fixed columns: their diagonals move up */
+                for (size_t q = (size_t)ptr[j2]; q < (size_t)ptr[j2] + len; q++)
+                    k->row_idx[q] = (int32_t)new_row(k->row_idx[q], n_free_old, shift);
             j = j2 - 1;
             continue;
         }
         int64_t o = jo >= 0 ? k->col_ptr[jo + 1] - 1 : -1, o_begin = jo >= 0 ? k->col_ptr[jo] : 0;
         int64_t q = (int64_t)pe - 1, d = ptr[j + 1] - 1;
         while (o >= o_begin || q >= (int64_t)pb) {
-            int64_t r_old = o >= o_begin ? k->row_idx[o] : -1;
+            int64_t r_old = o >= o_begin ? new_row(k->row_idx[o], n_free_old, shift) : -1;
             int64_t r_new = q >= (int64_t)pb ? pairs[q] % order : -1;
             int64_t r = r_old > r_new ? r_old : r_new;
             double v = r_old == r ? k->values[o--] : 0.0;
