@@ -925,11 +925,12 @@ static void test_adjacency(void)
     CHECK(m.pos == NULL && m.n_nodes == 0);
 }
 
-/* Adds a node at position p (copying nothing else). */
+/* Adds a node at position p (which may point into m->pos, which moves). */
 static int32_t add_node(fs_mesh *m, const double p[3])
 {
+    double q[3] = {p[0], p[1], p[2]};
     m->pos = realloc(m->pos, 3 * ((size_t)m->n_nodes + 1) * sizeof *m->pos);
-    memcpy(m->pos + 3 * (size_t)m->n_nodes, p, 3 * sizeof *p);
+    memcpy(m->pos + 3 * (size_t)m->n_nodes, q, sizeof q);
     return m->n_nodes++;
 }
 
