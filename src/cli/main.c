@@ -9,6 +9,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "base/threads.h"
 #include "cli/cli.h"
 #include "config.h"
 #include "io/obj.h"
@@ -72,6 +73,7 @@ static const struct option long_options[] = {
     {"dump-preset", no_argument, NULL, OPT_DUMP},
     {"mesh", required_argument, NULL, OPT_MESH},
     {"frames", required_argument, NULL, OPT_FRAMES},
+    {"threads", required_argument, NULL, 'j'},
     {"help", no_argument, NULL, 'h'},
     {"version", no_argument, NULL, 'V'},
     {NULL, 0, NULL, 0},
@@ -102,6 +104,8 @@ static void print_help(FILE *out)
           "      --frames N          also write N time-lapse frames NAME_frame_0001_MAP.png ... of the\n"
           "                          crack growth (maps: those of --maps that are texture maps, else\n"
           "                          basecolor and crackmask; springs and wedge models only)\n"
+          "  -j, --threads N         run parallel work on at most N threads, 1 to 256, or 0 for one\n"
+          "                          per processor (default); the results do not depend on N\n"
           "  -q, --quiet             print nothing on stderr but errors\n"
           "  -v, --verbose           print details of each phase on stderr\n"
           "      --list-presets      list the presets on the preset path, one a line, and exit\n"
@@ -166,7 +170,7 @@ static bool parse_maps(const char *list, bool *maps)
 static int parse_options(int argc, char **argv, options *o)
 {
     int c;
-    while ((c = getopt_long(argc, argv, "o:n:s:qvhV", long_options, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:n:s:j:qvhV", long_options, NULL)) != -1) {
         switch (c) {
         case 'o': o->output_dir = optarg; break;
         case 'n':
@@ -224,6 +228,17 @@ static int parse_options(int argc, char **argv, options *o)
                 return usage_error("--frames: expected a number of frames from 1 to 10000, got '%s'",
                                    optarg);
             o->frames = (int32_t)v;
+            break;
+        }
+        case 'j': {
+            char *end;
+            errno = 0;
+            long v = strtol(optarg, &end, 10);
+            if (end == optarg || *end || errno || v < 0 || v > FS_THREADS_MAX)
+                return usage_error("--threads: expected a number of threads from 1 to 256, or 0 for one per "
+                                   "processor, got '%s'",
+                                   optarg);
+            fs_threads_set((int)v);
             break;
         }
         case 'q': fs_log_set_level(FS_LOG_QUIET); break;

@@ -8,9 +8,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "base/error.h"
+#include "base/threads.h"
 #include "base/vec.h"
 
 /* Two corners whose sine of angle is below this are treated as collinear (a zero-area triangle). */
@@ -722,13 +722,13 @@ static void *block_worker_main(void *arg)
     }
 }
 
-/* Runs the blocks on up to one thread per processor; the result does not depend on the thread
+/* Runs the blocks on up to fs_threads() threads (base/threads.h); the result does not depend on the thread
  * count nor on which thread runs which block (each block's output depends only on the input).
  * Threads that cannot be started leave their blocks to the others. */
 static void run_blocks(block_job *jobs, int njobs)
 {
-    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-    int nthreads = ncpu < 1 ? 1 : (ncpu < njobs ? (int)ncpu : njobs);
+    int budget = fs_threads();
+    int nthreads = budget < njobs ? budget : njobs;
     block_queue q = {jobs, njobs, 0, PTHREAD_MUTEX_INITIALIZER};
     pthread_t thread[MAX_BLOCKS];
     bool started[MAX_BLOCKS] = {false};

@@ -5,10 +5,10 @@
 #include <pthread.h>
 #include <stdbool.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "base/error.h"
 #include "base/rng.h"
+#include "base/threads.h"
 #include "base/vec.h"
 
 #define SAMPLE_MAX_COUNT 50000000
@@ -210,7 +210,7 @@ static int32_t particle_bucket(const relax_state *s, int32_t i)
     return best;
 }
 
-/* design: the passes of an iteration run on up to one thread per processor (MAX_THREADS), and the
+/* design: the passes of an iteration run on up to fs_threads() threads (at most MAX_THREADS), and the
  * result does not depend on the thread count: per-particle passes split the particles into
  * contiguous ranges, the bucket sort stays stable (each range counts its own buckets, and a range's
  * particles go after those of the ranges before it), and the force pass keeps the sequential order
@@ -866,8 +866,8 @@ int fs_sample_repulsion(const fs_domain *domain, const fs_sample_params *params,
     else
         setup_grid_2d(&s, dmax);
     s.start = fs_malloc(((size_t)s.n_buckets + 1) * sizeof *s.start);
-    long ncpu = n >= PARALLEL_MIN_COUNT ? sysconf(_SC_NPROCESSORS_ONLN) : 1;
-    s.nthreads = ncpu < 1 ? 1 : (ncpu > MAX_THREADS ? MAX_THREADS : (int)ncpu);
+    int budget = n >= PARALLEL_MIN_COUNT ? fs_threads() : 1;
+    s.nthreads = budget > MAX_THREADS ? MAX_THREADS : budget;
     s.tcount = fs_malloc((size_t)s.nthreads * (size_t)s.n_buckets * sizeof *s.tcount);
 
     int iters = params->iterations;

@@ -902,6 +902,109 @@ static void node_pos(const fs_spring_net *net, int32_t p, const double *off, dou
         out[q] = net->x[3 * (size_t)p + q] + off[q];
 }
 
+/* The member of corner k's junction that is the cell across mesh edge `edge` from k's own (an edge
+ * of the junction at k's member), or -1 if none. */
+static int across_member(const post_ctx *c, const corner *k, int32_t edge)
+{
+    const junction *jn = c->junctions + k->junction;
+    int m = k->member;
+    if (edge < 0)
+        return -1;
+    if (jn->count == 3)
+        return jn->edge[m] == edge ? (m + 1) % 3 : (jn->edge[(m + 2) % 3] == edge ? (m + 2) % 3 : -1);
+    return jn->count == 2 && jn->edge[0] == edge ? 1 - m : -1;
+}
+
+/* Whether the cell of the polygon side from corner ka to kb shares the nodes at both of the side's
+ * junctions with its neighbour across the side, at level: there the two cells are joined, whatever
+ * the spring between them. */
+static bool side_joined(const post_ctx *c, const corner *ka, const corner *kb, int level)
+{
+    const corner *k[2] = {ka, kb};
+    for (int q = 0; q < 2; q++) {
+        int other = across_member(c, k[q], ka->edge_after);
+        size_t base = ((size_t)level * (size_t)c->n_junctions + (size_t)k[q]->junction) * 3;
+        if (other < 0 || c->group_node[base + (size_t)k[q]->member] != c->group_node[base + (size_t)other])
+            return false;
+    }
+    return true;
+}
+
+/* Twice the signed area of (a, b, d) in texture space (plane and cylinder). */
+static double uv_area2(const double *a, const double *b, const double *d)
+{
+    return (b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0]);
+}
+
+/* design: a cell's top is a fan from its centre node to its corners, but the relaxed centre can
+ * leave the part of the polygon from which every side is seen (the kernel), and a fan triangle then
+ * folds over its side, drawing a flap beyond the cell over the crack. Such a top (plane and
+ * cylinder) is instead cut into ears of its corner polygon, the centre splitting the ear that holds
+ * it (or left out if it lies outside the polygon). Returns true if the fan is fine and nothing was
+ * emitted; false when the top was emitted here. */
+static bool emit_top_folded(const post_ctx *c, fs_render_mesh *out, const emit_vertex *centre, const emit_vertex *ring,
+                            int32_t nk)
+{
+    if (c->sphere || nk > 64)
+        return true;
+    double uv[65][2], h;
+    to_texture(c, centre->p, uv[64], &h);
+    for (int32_t k = 0; k < nk; k++)
+        to_texture(c, ring[k].p, uv[k], &h);
+    bool folded = false;
+    for (int32_t k = 0; k < nk && !folded; k++)
+        folded = uv_area2(uv[64], uv[k], uv[(k + 1) % nk]) <= 0.0;
+    if (!folded)
+        return true;
+    int32_t idx[64], n = nk, ears[64][3], n_ears = 0;
+    for (int32_t k = 0; k < nk; k++)
+        idx[k] = k;
+    while (n > 3) {
+        int32_t ear = -1;
+        for (int32_t k = 0; k < n && ear < 0; k++) {
+            const double *a = uv[idx[(k + n - 1) % n]], *b = uv[idx[k]], *d = uv[idx[(k + 1) % n]];
+            if (uv_area2(a, b, d) <= 0.0)
+                continue;
+            bool empty = true;
+            for (int32_t j = 0; j < n && empty; j++) {
+                if (j == k || j == (k + 1) % n || j == (k + n - 1) % n)
+                    continue;
+                const double *x = uv[idx[j]];
+                empty = !(uv_area2(a, b, x) >= 0.0 && uv_area2(b, d, x) >= 0.0 && uv_area2(d, a, x) >= 0.0);
+            }
+            if (empty)
+                ear = k;
+        }
+        if (ear < 0)
+            return true; /* not a simple polygon: keep the fan */
+        ears[n_ears][0] = idx[(ear + n - 1) % n];
+        ears[n_ears][1] = idx[ear];
+        ears[n_ears][2] = idx[(ear + 1) % n];
+        n_ears++;
+        for (int32_t j = ear; j + 1 < n; j++)
+            idx[j] = idx[j + 1];
+        n--;
+    }
+    if (uv_area2(uv[idx[0]], uv[idx[1]], uv[idx[2]]) <= 0.0)
+        return true; /* a polygon that crosses itself (a corner pushed over a side): keep the fan */
+    memcpy(ears[n_ears++], idx, sizeof ears[0]);
+    bool placed = false;
+    for (int32_t e = 0; e < n_ears; e++) {
+        const emit_vertex *v[3] = {ring + ears[e][0], ring + ears[e][1], ring + ears[e][2]};
+        bool inside = !placed;
+        for (int k = 0; k < 3 && inside; k++)
+            inside = uv_area2(uv[ears[e][k]], uv[ears[e][(k + 1) % 3]], uv[64]) > 0.0;
+        if (!inside) {
+            emit_tri(c, out, v[0], v[1], v[2], 0, true);
+            continue;
+        }
+        placed = true;
+        for (int k = 0; k < 3; k++)
+            emit_tri(c, out, centre, v[k], v[(k + 1) % 3], 0, true);
+    }
+    return false;
+}
+
 static void emit(const post_ctx *c, const fs_spring_net *net, fs_render_mesh *out)
 {
     const fs_springs *s = c->s;
@@ -910,6 +1013,8 @@ static void emit(const post_ctx *c, const fs_spring_net *net, fs_render_mesh *ou
     fs_springs_fragments(s, label);
     uint64_t seed = s->setup.seed;
     int top = c->L;
+    emit_vertex *ring = NULL;
+    int32_t cap_ring = 0;
     for (int32_t i = 0; i < n; i++) {
         int32_t k0 = c->corner_start[i], k1 = c->corner_start[i + 1], nk = k1 - k0;
         if (nk < 3)
@@ -921,17 +1026,28 @@ static void emit(const post_ctx *c, const fs_spring_net *net, fs_render_mesh *ou
         static const double zero[3] = {0.0, 0.0, 0.0};
         emit_vertex centre = cell_v;
         node_pos(net, c->center_node[(size_t)top * (size_t)n + (size_t)i], zero, centre.p);
+        if (nk > cap_ring) {
+            cap_ring = nk;
+            ring = fs_realloc(ring, (size_t)cap_ring * sizeof *ring);
+        }
+        for (int32_t kk = 0; kk < nk; kk++) {
+            double o[3];
+            ring[kk] = cell_v;
+            node_pos(net, corner_node(c, c->corners + k0 + kk, top, o), o, ring[kk].p);
+        }
+        bool fan = emit_top_folded(c, out, &centre, ring, nk);
         for (int32_t kk = 0; kk < nk; kk++) {
             const corner *ka = c->corners + k0 + kk, *kb = c->corners + k0 + (kk + 1) % nk;
             double oa[3], ob[3];
-            emit_vertex va = cell_v, vb = cell_v;
-            node_pos(net, corner_node(c, ka, top, oa), oa, va.p);
-            node_pos(net, corner_node(c, kb, top, ob), ob, vb.p);
-            emit_tri(c, out, &centre, &va, &vb, 0, true);
-            /* open walls: on a border, or down through the layers whose spring broke */
+            if (fan)
+                emit_tri(c, out, &centre, ring + kk, ring + (kk + 1) % nk, 0, true);
+            /* open walls: on a border, or down through the layers whose spring broke, unless the
+             * cells still share their nodes at both ends above and below the layer (a broken
+             * spring whose junctions the other springs around them hold together: the wall would
+             * have no width, and the two cells would each draw it) */
             for (int l = c->L - 1; l >= 0; l--) {
                 bool open = ka->edge_after < 0 || !intact(c, l, ka->edge_after);
-                if (!open)
+                if (!open || (side_joined(c, ka, kb, l + 1) && side_joined(c, ka, kb, l)))
                     continue;
                 emit_vertex a1 = wall_v, b1 = wall_v, a0 = wall_v, b0 = wall_v;
                 node_pos(net, corner_node(c, ka, l + 1, oa), oa, a1.p);
@@ -943,6 +1059,7 @@ static void emit(const post_ctx *c, const fs_spring_net *net, fs_render_mesh *ou
             }
         }
     }
+    free(ring);
     free(label);
 }
 

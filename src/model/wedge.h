@@ -380,8 +380,10 @@ int fs_wedge_update_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n);
 /* The render mesh of the current state (SPEC §6, texture space, see render.h): the top surface of the
  * living elements (height = top of the layer in cm, crack 0, cell = connected fragment + 1 (wrapping
  * past 65535), shade per fragment) and the floor of removed elements (height 0, crack 1, cell 0).
- * With fracture by splitting, a floor under every element and the top surface at the in-plane
- * displaced top-node positions, so the cracks open (wedge_render.c).
+ * With fracture by splitting, the top surface at the in-plane displaced top-node positions (so the
+ * cracks open) and a floor (height 0, crack 1, cell 0) exactly in the gaps between the fragments:
+ * on the plane and cylinder the mesh partitions texture space, tops and floor meeting vertex to
+ * vertex, so that the lift closes every crack with walls (wedge_render.c).
  * Fragments are the connected components of living elements sharing a node. Returns 0 or -1. */
 int fs_wedge_render_mesh(const fs_wedge_model *w, fs_render_mesh *out);
 

@@ -7,10 +7,12 @@
 #include <GL/glext.h>
 
 #include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/error.h"
+#include "base/threads.h"
 
 /* design: gallium OSMesa (Mesa 22.3) renders into an internal resource of the format chosen by the
  * buffer type (GL_FLOAT gives R32G32B32A32_FLOAT) and copies it to the caller's buffer on glFinish,
@@ -50,8 +52,25 @@ static int gl_check(const char *what)
     return 0;
 }
 
+/* design: llvmpipe rasterises on a pool of threads it sizes when it creates its screen, at the
+ * first context of the process, from LP_NUM_THREADS (else the processors); tiles are drawn whole by
+ * one thread, so the image does not depend on the count. With a thread budget given (-j; base/
+ * threads.h), LP_NUM_THREADS is set to it before that first context (the calling thread waits
+ * while they draw). */
+static void apply_raster_threads(void)
+{
+    static bool done;
+    if (done || !fs_threads_given())
+        return;
+    done = true;
+    char n[16];
+    snprintf(n, sizeof n, "%d", fs_threads());
+    setenv("LP_NUM_THREADS", n, 1);
+}
+
 fs_osmesa *fs_osmesa_create(int width, int height)
 {
+    apply_raster_threads();
     FS_ASSERT(width > 0 && height > 0);
     fs_osmesa *g = fs_calloc(1, sizeof *g);
     g->width = width;

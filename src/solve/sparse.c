@@ -1,12 +1,16 @@
 /* Sparse symmetric assembly and products, and the only CHOLMOD user: sparse Cholesky for the equilibrium solves. */
 #include "solve/sparse.h"
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
 #include <cholmod.h>
+#include <dlfcn.h>
 
 #include "base/error.h"
+#include "base/log.h"
+#include "base/threads.h"
 
 _Static_assert(sizeof(int) == sizeof(int32_t), "the int interface of CHOLMOD reads our int32_t arrays");
 
@@ -323,8 +327,43 @@ void fs_cholesky_free(fs_cholesky *c)
     free(c);
 }
 
+/* design: CHOLMOD's supernodal factorization and solves spend their time in the BLAS, which is
+ * whatever libblas.so.3 the system provides (fissure links CHOLMOD only). OpenBLAS, Debian's usual
+ * one, runs its own thread pool, sized when it loads (before main) from OPENBLAS_NUM_THREADS or
+ * OMP_NUM_THREADS, or the processors; setting those variables from main is too late. Its run-time
+ * entry openblas_set_num_threads resizes the pool, so when a thread budget was given (-j; base/
+ * threads.h) it is looked up in the process (dlsym, no link-time dependency) and called with the
+ * budget whenever that differs from what it was last given. Without -j, and with another BLAS, the
+ * BLAS keeps its own setting (its environment variables, else the processors). The
+ * factor does not depend on the count: OpenBLAS splits its kernels' output blocks among threads,
+ * each block summed in one order (tests/cli_threads.sh compares -j 1 and -j 2 byte for byte). */
+static void apply_blas_threads(void)
+{
+    if (!fs_threads_given())
+        return;
+    static bool looked_up;
+    static void (*set_threads)(int);
+    static int applied;
+    if (!looked_up) {
+        looked_up = true;
+        void *self = dlopen(NULL, RTLD_LAZY);
+        if (self) {
+            *(void **)(&set_threads) = dlsym(self, "openblas_set_num_threads");
+            dlclose(self);
+        }
+        fs_debug("cholmod: BLAS threads %s", set_threads ? "set through openblas_set_num_threads"
+                                                         : "left to the BLAS (not OpenBLAS)");
+    }
+    int n = fs_threads();
+    if (set_threads && n != applied) {
+        set_threads(n);
+        applied = n;
+    }
+}
+
 fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a)
 {
+    apply_blas_threads();
     fs_cholesky *c = fs_calloc(1, sizeof *c);
     cholmod_message[0] = '\0';
     if (!cholmod_start(&c->common)) {
