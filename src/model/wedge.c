@@ -1069,7 +1069,7 @@ int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg)
     w->mesh = mesh;
     w->cfg = *cfg;
     if (cfg->solver.relax == FS_RELAX_AUTO) /* see fs_solver_params and thesis §5.8 */
-        w->cfg.solver.relax = cfg->fracture.method == FS_FRACTURE_SPLIT ? FS_RELAX_LOCAL : FS_RELAX_GLOBAL;
+        w->cfg.solver.relax = FS_RELAX_LOCAL;
     fs_domain_normalize(&w->mesh->domain);
     const fs_domain *d = &mesh->domain;
     w->flat = d->type != FS_DOMAIN_SPHERE;

@@ -50,8 +50,8 @@ typedef struct {
     double tolerance;       /* cg: relative residual ||b - Ax|| / ||b|| to stop at */
     int32_t max_iterations; /* cg: iteration limit, 0 for the number of unknowns */
     fs_relax_mode relax;    /* after a local change (a fracture): relax the whole model, or first
-                               only the nodes around the change (thesis §5.8); auto: local when
-                               fracturing by splitting, global by removal */
+                               only the nodes around the change (thesis §5.8); auto: local
+                               (faster for both fracture methods, the same patterns) */
     double relax_radius;    /* local: initial radius of the relaxed region, in mean edge lengths */
     double relax_tolerance; /* local: a local relaxation is accepted when no residual entry of
                                f - K u exceeds relax_tolerance times the root mean square of f */
