@@ -102,7 +102,8 @@ static double residual(fs_wedge_model *w, double *r)
         if (uj == 0.0)
             continue;
         for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++)
-            w->rhs[k->row_idx[p]] -= k->values[p] * uj;
+            if (k->row_idx[p] < nf) /* not the (zero) diagonal every column stores (solve/sparse.h) */
+                w->rhs[k->row_idx[p]] -= k->values[p] * uj;
     }
     double b2 = 0.0;
     for (int32_t i = 0; i < nf; i++) {
