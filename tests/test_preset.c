@@ -33,6 +33,10 @@ static const char *const full_preset =
     "lattice = hex\n"
     "relax_iterations = 0\n"
     "radius_jitter = 0.9\n"
+    "refine_vm = 0.35\n"
+    "refine_vm_rounds = 7\n"
+    "smooth_radius = 2.5\n"
+    "smooth_iterations = 5\n"
     "[material]\n"
     "young = 12000.5\n"
     "poisson = 0.499\n"
@@ -57,6 +61,9 @@ static const char *const full_preset =
     "[fracture]\n"
     "method = remove\n"
     "griffith = off\n"
+    "tip_submodel = on\n"
+    "tip_submodel_radius = 6\n"
+    "tip_submodel_size = 0.125\n"
     "[time]\n"
     "end = 2.5\n"
     "min_step = 0.001\n"
@@ -123,6 +130,10 @@ static const char *config_diff(const fs_config *a, const fs_config *b, double co
     SAME(mesh.lattice);
     SAME(mesh.relax_iterations);
     SAME(mesh.radius_jitter);
+    SAME(mesh.refine_vm);
+    SAME(mesh.refine_vm_rounds);
+    SAME(mesh.smooth_radius);
+    SAME(mesh.smooth_iterations);
     SAME(material.young);
     SAME(material.poisson);
     SAME(material.threshold);
@@ -145,6 +156,9 @@ static const char *config_diff(const fs_config *a, const fs_config *b, double co
         return "shrink.bottom";
     SAME(fracture.method);
     SAME(fracture.griffith);
+    SAME(fracture.tip_submodel);
+    SAME(fracture.tip_submodel_radius);
+    SAME(fracture.tip_submodel_size);
     SAME(time.end);
     SAME(time.min_step);
     SAME(render.width);
@@ -214,6 +228,9 @@ static void test_defaults(void)
     CHECK(c.growth.angle == 0 && c.growth.rate == 1 && c.growth.axis_ratio == 1);
     CHECK(c.shrink.top.n == 0 && c.shrink.bottom.n == 0);
     CHECK(c.fracture.method == FS_FRACTURE_SPLIT && c.fracture.griffith);
+    CHECK(!c.fracture.tip_submodel && c.fracture.tip_submodel_radius == 4.0 && c.fracture.tip_submodel_size == 0.25);
+    CHECK(c.mesh.refine_vm == 0.0 && c.mesh.refine_vm_rounds == 3 && c.mesh.smooth_radius == 0.0 &&
+          c.mesh.smooth_iterations == 3);
     CHECK(c.time.end == 1.0 && c.time.min_step == 1e-4);
     CHECK(!strcmp(fs_model_name(FS_MODEL_SHELL), "shell"));
     CHECK(!strcmp(fs_growth_type_name(FS_GROWTH_CYLINDER), "cylinder"));
@@ -247,6 +264,9 @@ static void test_full_preset(void)
     CHECK(c.shrink.top.n == 3 && c.shrink.top.t[1] == 0.5 && c.shrink.top.v[2] == 0.1);
     CHECK(c.shrink.bottom.n == 1 && c.shrink.bottom.v[0] == -0.5);
     CHECK(c.fracture.method == FS_FRACTURE_REMOVE && !c.fracture.griffith);
+    CHECK(c.fracture.tip_submodel && c.fracture.tip_submodel_radius == 6.0 && c.fracture.tip_submodel_size == 0.125);
+    CHECK(c.mesh.refine_vm == 0.35 && c.mesh.refine_vm_rounds == 7 && c.mesh.smooth_radius == 2.5 &&
+          c.mesh.smooth_iterations == 5);
     CHECK(c.render.width == 640 && c.render.height == 480 && c.render.supersample == 8);
     CHECK(c.render.normal == FS_NORMAL_DIRECTX);
     /* Colours are decoded from sRGB: black stays 0, 0xD0 = 208 is 0.6308 in linear light. */
@@ -302,7 +322,7 @@ static void test_errors(void)
          "fracture, time, render, voronoi, solver, wedge, springs"},
         {"[mesh]\n\nelement = 100\n",
          "t.ini:3: unknown key [mesh] element: expected one of: elements, min_size, lattice, relax_iterations, "
-         "radius_jitter"},
+         "radius_jitter, refine_vm, refine_vm_rounds, smooth_radius, smooth_iterations"},
         {"[material]\nyoung = 10e\n", "t.ini:2: [material] young: expected a number > 0 (MPa), got '10e'"},
         {"[material]\nyoung = \n", "t.ini:2: [material] young: expected a number > 0 (MPa), got ''"},
         {"[material]\npoisson = 0.5\n", "t.ini:2: [material] poisson: expected a number in [0, 0.499], got '0.5'"},
@@ -323,6 +343,10 @@ static void test_errors(void)
          "t.ini:2: [render] size: expected WIDTHxHEIGHT in pixels, each in 16..16384, got '1024 x 1024'"},
         {"[render]\ncolor_crack = #12345g\n", "t.ini:2: [render] color_crack: expected an sRGB colour #rrggbb, got '#12345g'"},
         {"[fracture]\ngriffith = maybe\n", "t.ini:2: [fracture] griffith: expected true or false, got 'maybe'"},
+        {"[mesh]\nrefine_vm = -0.1\n", "t.ini:2: [mesh] refine_vm: expected a number in [0, 100], got '-0.1'"},
+        {"[mesh]\nsmooth_iterations = 0\n", "t.ini:2: [mesh] smooth_iterations: expected an integer in 1..100, got '0'"},
+        {"[fracture]\ntip_submodel_size = 0\n",
+         "t.ini:2: [fracture] tip_submodel_size: expected a number in [0.01, 1] (edge lengths), got '0'"},
         {"[time]\nend = 2\n\n[time]\nend = 3\n",
          "t.ini:5: [time] end: expected one value (already set on line 2), got '3'"},
         {"# comment\nseed = 3\n[preset]\n",

@@ -91,6 +91,10 @@ static const key_def key_table[] = {
     {"mesh", "lattice", KEY_WORD, OFF(mesh.lattice), 0, 0, 0, lattice_words, NULL},
     {"mesh", "relax_iterations", KEY_INT, OFF(mesh.relax_iterations), 0, 1000, GE | LE, NULL, NULL},
     {"mesh", "radius_jitter", KEY_REAL, OFF(mesh.radius_jitter), 0, 0.9, GE | LE, NULL, NULL},
+    {"mesh", "refine_vm", KEY_REAL, OFF(mesh.refine_vm), 0, 100, GE | LE, NULL, NULL},
+    {"mesh", "refine_vm_rounds", KEY_INT, OFF(mesh.refine_vm_rounds), 1, 100, GE | LE, NULL, NULL},
+    {"mesh", "smooth_radius", KEY_REAL, OFF(mesh.smooth_radius), 0, 100, GE | LE, NULL, "edge lengths"},
+    {"mesh", "smooth_iterations", KEY_INT, OFF(mesh.smooth_iterations), 1, 100, GE | LE, NULL, NULL},
 
     {"material", "young", KEY_REAL, OFF(material.young), 0, 0, GT, NULL, "MPa"},
     {"material", "poisson", KEY_REAL, OFF(material.poisson), 0, 0.499, GE | LE, NULL, NULL},
@@ -115,6 +119,11 @@ static const key_def key_table[] = {
 
     {"fracture", "method", KEY_WORD, OFF(fracture.method), 0, 0, 0, method_words, NULL},
     {"fracture", "griffith", KEY_BOOL, OFF(fracture.griffith), 0, 0, 0, NULL, NULL},
+    {"fracture", "tip_submodel", KEY_BOOL, OFF(fracture.tip_submodel), 0, 0, 0, NULL, NULL},
+    {"fracture", "tip_submodel_radius", KEY_REAL, OFF(fracture.tip_submodel_radius), 1, 100, GE | LE, NULL,
+     "edge lengths"},
+    {"fracture", "tip_submodel_size", KEY_REAL, OFF(fracture.tip_submodel_size), 0.01, 1, GE | LE, NULL,
+     "edge lengths"},
 
     {"time", "end", KEY_REAL, OFF(time.end), 0, 0, GT, NULL, NULL},
     {"time", "min_step", KEY_REAL, OFF(time.min_step), 0, 0, GT, NULL, NULL},

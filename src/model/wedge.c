@@ -1063,7 +1063,8 @@ static void grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
     w->n_elems = n_elems;
 }
 
-int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg)
+/* fs_wedge_init, with the assembly and factorization left out unless assemble is set. */
+static int init_model(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg, bool assemble)
 {
     memset(w, 0, sizeof *w);
     w->mesh = mesh;
@@ -1111,11 +1112,21 @@ int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg)
     map_free(&tmap);
 
     w->assembled_thickness = layer_thickness(w, 0.0);
-    if (build_system(w) < 0) {
+    if (assemble && build_system(w) < 0) {
         fs_wedge_free(w);
         return -1;
     }
     return 0;
+}
+
+int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg)
+{
+    return init_model(w, mesh, cfg, true);
+}
+
+int fs_wedge_init_unassembled(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg)
+{
+    return init_model(w, mesh, cfg, false);
 }
 
 int fs_wedge_pin_top(fs_wedge_model *w, const uint8_t *pinned)
@@ -1159,6 +1170,7 @@ void fs_wedge_free(fs_wedge_model *w)
     fs_cholesky_free(w->chol);
     free(w->tip_node);
     free(w->tip_dir);
+    free(w->tip_scale);
     memset(w, 0, sizeof *w);
 }
 
@@ -1722,6 +1734,36 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
     if (rc < 0)
         return -1;
     return pattern_changed(w);
+}
+
+int fs_wedge_update_geometry(fs_wedge_model *w, const int32_t *elems, int32_t n)
+{
+    double t0 = fs_seconds();
+    int32_t *nodes = fs_malloc((3 * (size_t)n + 1) * sizeof *nodes);
+    int32_t nn = 0;
+    for (int32_t q = 0; q < n; q++)
+        for (int k = 0; k < 3; k++)
+            nodes[nn++] = w->mesh->tri[3 * (size_t)elems[q] + k];
+    int rc = update_region(w, nodes, nn);
+    if (w->n_dirty + nn > w->cap_dirty) { /* their rows of f - K u changed (wedge_relax.c) */
+        w->cap_dirty = 2 * (w->n_dirty + nn);
+        w->dirty_nodes = fs_realloc(w->dirty_nodes, (size_t)w->cap_dirty * sizeof *w->dirty_nodes);
+    }
+    memcpy(w->dirty_nodes + w->n_dirty, nodes, (size_t)nn * sizeof *nodes);
+    w->n_dirty += nn;
+    if (rc == 0)
+        rc = refresh_cache(w, elems, n);
+    if (rc == 0)
+        rc = element_ratios(w, elems, n);
+    free(nodes);
+    w->counters.assemble_seconds += fs_seconds() - t0;
+    if (rc < 0)
+        return -1;
+    if (w->cfg.solver.relax == FS_RELAX_LOCAL && w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
+        w->factor_stale = true; /* the analysis still fits: fs_wedge_refactor only re-factorizes */
+        return 0;
+    }
+    return factorize(w, false);
 }
 
 double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e)

@@ -76,6 +76,16 @@ typedef struct {
     double event_relax_seconds; /* their time, local or global */
     double event_seconds;      /* the events' whole time: the fracture (the cut, the system's update or
                                   re-factorization) and the relaxation */
+    int64_t vm_rounds;         /* rounds of refinement by von Mises discontinuity that bisected (wedge_tips.c) */
+    int64_t vm_bisections;     /* their bisections (also counted in subdivisions) */
+    double vm_seconds;         /* their time: indicators, subdivision, re-solves */
+    int64_t submodels;         /* crack-tip sub-models solved (wedge_tips.c) */
+    int64_t submodel_elements; /* their elements after refinement, summed */
+    int64_t submodel_rejections; /* picked tips the sub-model found below their threshold */
+    double submodel_seconds;   /* their time: extraction, refinement, assembly, solve */
+    int64_t smoothings;        /* angle-smoothing passes around new tips (wedge_tips.c) */
+    int64_t smoothed_nodes;    /* nodes they moved */
+    double smooth_seconds;     /* their time, the system's update included (not the relaxation) */
 } fs_wedge_counters;
 
 /* The whole state of one layer. Arrays are flat and indexed by mesh node or mesh triangle (one wedge
@@ -169,6 +179,10 @@ typedef struct {
     int32_t n_tips, cap_tips;
     int32_t *tip_node;           /* mesh node of each tip */
     double *tip_dir;             /* 3 per tip: unit direction the crack arrived in (model frame) */
+    double *tip_scale;           /* per tip: factor on its coarse ratio, the last sub-model ratio over the
+                                    coarse ratio then (fracture.tip_submodel, wedge_tips.c), else 1 */
+    double tips_unit;            /* mean edge length (cm) of the living elements at the first use of the
+                                    sub-model or smoothing radius: their unit; 0 before */
     int64_t griffith_stops;      /* tips retired by the Griffith criterion */
 } fs_wedge_model;
 
@@ -180,6 +194,12 @@ typedef struct {
  * E or nu out of range, a degenerate element), FS_ERR_NOINPUT for a missing map image,
  * FS_ERR_INTERNAL if the factorization fails. On failure the model is freed. */
 int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg);
+
+/* fs_wedge_init without the assembly: the node and element arrays are filled (materials, thickness
+ * factors, prescribed values) but there is no system yet, so the caller may change them and must then
+ * call fs_wedge_pin_top, which assembles and factorizes; nothing else may be called before. For
+ * models built from another one's data (wedge_tips.c's sub-models). Returns 0 or -1 as fs_wedge_init. */
+int fs_wedge_init_unassembled(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg);
 
 /* Releases everything the model owns (not the mesh) and zeroes it. */
 void fs_wedge_free(fs_wedge_model *w);
@@ -299,6 +319,14 @@ typedef struct {
  * re-solve. Returns 0 or -1. */
 int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c);
 
+/* Brings the model up to a change of geometry without a change of the mesh's connectivity (nodes
+ * moved in place by the caller, as smoothing does): the listed elements' (ascending, no duplicates)
+ * stiffnesses, loads and caches are rebuilt, and so are the entries of the system around their nodes
+ * (same pattern) and their stresses at the current displacements; their nodes' residual rows are
+ * marked for fs_wedge_relax. The factor is re-factorized, or with solver.relax = local marked stale
+ * (w->factor_stale, its analysis kept). Does not re-solve. Returns 0 or -1 with fs_error. */
+int fs_wedge_update_geometry(fs_wedge_model *w, const int32_t *elems, int32_t n);
+
 /* Elastic strain energy (MPa cm^3 = J) of living element e at the current equilibrium: half the dot
  * product of its nodal forces and displacements net of the shrinkage reference shape and growth
  * eigenstrain (thesis Algorithm 11). 0 for a removed element; NaN if the element degenerates. */
@@ -306,14 +334,17 @@ double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e);
 
 /* One fracture event by element splitting at the current time (thesis §5.7, Algorithms 10-12; see
  * wedge_split.c): the crack tip with the largest nodal ratio over 1 extends, or if no tip is over its
- * threshold, a new crack starts at the node with the largest ratio over 1. Does not re-solve unless
- * Griffith needs the new equilibrium. *changed is 1 if the mesh changed, 0 if a tip was only retired.
- * Returns 0, 1 if no candidate is over its threshold (nothing done), or -1 with fs_error. */
+ * threshold, a new crack starts at the node with the largest ratio over 1. With fracture.tip_submodel
+ * the picked tip extends only if its sub-model ratio (fs_wedge_tip_submodel) is over 1 too, in the
+ * sub-model's direction; otherwise its tip_scale drops it below 1 and the next tip is tried. With
+ * mesh.smooth_radius the new tips' surroundings are smoothed (fs_wedge_smooth). Does not re-solve
+ * unless Griffith needs the new equilibrium. *changed is 1 if the mesh changed, 0 if a tip was only
+ * retired. Returns 0, 1 if no candidate is over its threshold (nothing done), or -1 with fs_error. */
 int fs_wedge_split_event(fs_wedge_model *w, int *changed);
 
-/* The largest nodal ratio among the split candidates at the current equilibrium (tips, and nodes off
- * every crack and boundary), -inf if none: what the split method's event search looks at. Fills the
- * nodal ratio cache of every candidate. */
+/* The largest nodal ratio among the split candidates at the current equilibrium (tips, their coarse
+ * estimate times tip_scale, and nodes off every crack and boundary), -inf if none: what the split
+ * method's event search looks at. Fills the nodal ratio cache of every candidate. */
 double fs_wedge_split_max_ratio(fs_wedge_model *w);
 
 /* fs_wedge_split_max_ratio of the state at time t blended between the snapshots a and b (taken right
@@ -334,6 +365,61 @@ int fs_wedge_refactor(fs_wedge_model *w);
  * next event (fs_event_find, resolution cfg.time.min_step). Progress through fs_progress. Returns 0
  * or -1 with fs_error. */
 int fs_wedge_simulate(fs_wedge_model *w, double t_end);
+
+/* ---- §5.7.7-5.7.9: refinement, sub-models and smoothing around crack tips (wedge_tips.c) ---- */
+
+/* Von Mises discontinuity indicator of every node (thesis §5.7.7, Algorithm 13) at the current
+ * stresses (stress_top, so the last equilibrium): the largest minus the smallest von Mises stress of
+ * its living elements at their top Gauss point nearest the node, divided by the largest principal
+ * stress at any of those points in the layer. indicator (n_nodes entries, may be NULL) gets NaN for a
+ * node without living elements and 0 everywhere when the largest principal stress is not positive.
+ * Returns the largest indicator (0 if none). */
+double fs_wedge_vm_discontinuity(const fs_wedge_model *w, double *indicator);
+
+/* Algorithm 13 at the current time, at most rounds times: the living elements at or above
+ * mesh.min_size around every node whose indicator exceeds threshold (> 0) are bisected once
+ * (fs_wedge_subdivide, conforming), and the model is solved again (fs_wedge_equilibrium). Stops
+ * early when nothing is marked or bisected. *bisected (may be NULL) receives the bisections.
+ * Returns 0 or -1 with fs_error. */
+int fs_wedge_refine_vm(fs_wedge_model *w, double threshold, int rounds, int32_t *bisected);
+
+/* What one crack-tip sub-model was (fs_wedge_tip_submodel). */
+typedef struct {
+    int32_t extracted_elems;     /* elements copied from the layer */
+    int32_t nodes, elems;        /* of the sub-model after refinement */
+    int32_t bisections;          /* Rivara bisections of the refinement */
+    double tip_size;             /* largest longest edge among the tip's elements after refinement (cm) */
+    double coarse_ratio;         /* the layer's own nodal ratio at the tip (§5.7.1 average) */
+} fs_wedge_submodel_info;
+
+/* Local multi-resolution sub-model at node (thesis §5.7.8, Fig. 5.24): the living elements with a
+ * corner within radius (cm, along the edges of living elements, fs_wedge_relax_region) of node are
+ * copied into a separate mesh and model with the layer's materials, thickness factors and time; the
+ * copied nodes beyond the radius are held at the layer's current displacement (bottom nodes keep
+ * their prescribed motion); the elements around node are bisected (Rivara) until they are below size
+ * (cm); the sub-model is solved. *ratio receives node's nodal ratio there (§5.7.1: its elements'
+ * stresses at their Gauss points nearest node averaged, the largest principal stress over their mean
+ * threshold) and m (may be NULL) the unit normal of that principal plane; info may be NULL. The layer
+ * is not changed (but for w->counters). Returns 0, or -1 with fs_error (a degenerate element, a
+ * failed solve); a node without living elements gives *ratio = -inf. */
+int fs_wedge_tip_submodel(fs_wedge_model *w, int32_t node, double radius, double size, double *ratio, double m[3],
+                          fs_wedge_submodel_info *info);
+
+/* Angle-based smoothing (thesis §5.7.9, Zhou and Shimada) of the nodes within radius (cm, along the
+ * edges of living elements) of the centres (n mesh nodes): every such node fully surrounded by living
+ * elements (not on a crack wall, a tip or the border) and not pinned is moved, iterations times in
+ * ascending order, towards the position that equalises its neighbours' angles, a move kept only if
+ * the smallest angle of its triangles does not decrease and it does not cross a periodic seam. The
+ * moved elements' geometry, reference shapes and stiffnesses, their stresses at the current
+ * displacements and the global system are then updated (fs_wedge_update_geometry); the
+ * model is not relaxed (call fs_wedge_relax, which sees the changed rows). *moved (may be NULL)
+ * receives the number of nodes moved. Returns 0 or -1 with fs_error. */
+int fs_wedge_smooth(fs_wedge_model *w, const int32_t *centres, int32_t n, double radius, int iterations,
+                    int32_t *moved);
+
+/* The unit of the sub-model and smoothing radii: w->tips_unit, set at the first call to the mean edge
+ * length (cm) of the living elements. */
+double fs_wedge_tips_unit(fs_wedge_model *w);
 
 /* design: thesis §5.8, adaptive local relaxation. After a local change of the model (an element
  * removed, split or its nodes duplicated, a node moved) only the nodes near the change move much.

@@ -118,10 +118,19 @@ static void report(const fs_wedge_model *w, double t_end)
  * is fs_wedge_split_event and the ratio the nodal one of the split candidates. When nothing
  * is over its threshold, fs_event_find advances to just past the next time something is (within
  * time.min_step), starting with a step of half the time since the previous event. */
+/* Adaptive refinement by von Mises discontinuity (thesis §5.7.7, Algorithm 13) after an equilibrium at
+ * a new time, when mesh.refine_vm is set (wedge_tips.c). Returns 0 or -1. */
+static int refine_at_new_time(fs_wedge_model *w)
+{
+    if (!(w->cfg.mesh.refine_vm > 0.0))
+        return 0;
+    return fs_wedge_refine_vm(w, w->cfg.mesh.refine_vm, w->cfg.mesh.refine_vm_rounds, NULL);
+}
+
 int fs_wedge_simulate(fs_wedge_model *w, double t_end)
 {
     double min_step = w->cfg.time.min_step;
-    if (fs_wedge_equilibrium(w, w->time) < 0)
+    if (fs_wedge_equilibrium(w, w->time) < 0 || refine_at_new_time(w) < 0)
         return -1;
     search_ctx search = {.w = w};
     const fs_event_fns fns = {exact_ratio, estimated_ratio};
@@ -170,6 +179,8 @@ int fs_wedge_simulate(fs_wedge_model *w, double t_end)
             if (rc < 0)
                 goto done;
         }
+        if (r.found && (rc = refine_at_new_time(w)) < 0)
+            goto done;
         report(w, t_end);
         if (!r.found)
             break;
@@ -210,6 +221,18 @@ int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, f
                  (long long)c->factorizations, c->factor_seconds, (long long)c->analyses, c->analyze_seconds,
                  (long long)c->updowns, c->update_seconds, c->assemble_seconds, c->stress_seconds,
                  (long long)c->cg_iterations);
+        if (cfg->mesh.refine_vm > 0.0)
+            fs_debug("wedge: von Mises refinement: %lld rounds, %lld bisections, %.2f s", (long long)c->vm_rounds,
+                     (long long)c->vm_bisections, c->vm_seconds);
+        if (cfg->fracture.tip_submodel)
+            fs_debug("wedge: tip sub-models: %lld, %.0f elements each, %lld found the tip below its threshold, "
+                     "%.2f s (%.2f ms each)", (long long)c->submodels,
+                     c->submodels ? (double)c->submodel_elements / (double)c->submodels : 0.0,
+                     (long long)c->submodel_rejections, c->submodel_seconds,
+                     c->submodels ? 1e3 * c->submodel_seconds / (double)c->submodels : 0.0);
+        if (cfg->mesh.smooth_radius > 0.0)
+            fs_debug("wedge: smoothing: %lld passes, %lld nodes moved, %.2f s", (long long)c->smoothings,
+                     (long long)c->smoothed_nodes, c->smooth_seconds);
     }
     fs_wedge_free(&w);
     return rc;

@@ -36,7 +36,9 @@
  * Tips: averaged over the elements around a tip, the nodal stress mixes the loaded element ahead of
  * the crack with the unloaded walls behind it and misses the stress concentration that the thesis
  * resolves with a temporary finer mesh at the tip (§5.7.8); this model takes instead, at a tip, the
- * largest ratio (and its direction) among the top Gauss points nearest the tip, one per element.
+ * largest ratio (and its direction) among the top Gauss points nearest the tip, one per element: the
+ * coarse estimate. With fracture.tip_submodel the thesis's sub-model (wedge_tips.c) decides for the
+ * tip about to extend, and calibrates that tip's estimate (see tip_submodel_check).
  *
  * Order (Fig. 5.20): tips first (largest ratio over 1 among tips), new cracks only when no tip is
  * over its threshold; new cracks start only at nodes off every crack and boundary (interior nodes).
@@ -54,6 +56,9 @@
  * Subdivision around tips (§5.7.6): before a node breaks, the elements of its one-ring and their
  * neighbours that are not yet below mesh.min_size are bisected (fs_wedge_subdivide) and the event
  * ends there; the model relaxes and the criterion is evaluated again on the finer mesh.
+ *
+ * Smoothing (§5.7.9, mesh.smooth_radius): after a cut, the free nodes around the new tips are moved
+ * by angle-based smoothing (fs_wedge_smooth, wedge_tips.c) before the model relaxes.
  *
  * The global system after a cut is updated in place for the changed elements (fs_wedge_apply_change)
  * and re-factorized; duplicated and new nodes start from the displacement of the nodes they came
@@ -244,7 +249,7 @@ double fs_wedge_split_max_ratio(fs_wedge_model *w)
 {
     double best = -INFINITY;
     for (int32_t k = 0; k < w->n_tips; k++)
-        best = fmax(best, tip_ratio(w, w->tip_node[k], NULL));
+        best = fmax(best, tip_ratio(w, w->tip_node[k], NULL) * w->tip_scale[k]);
     uint8_t *open = open_nodes(w);
     for (int32_t i = 0; i < w->n_nodes; i++)
         if (!open[i])
@@ -262,7 +267,7 @@ double fs_wedge_split_blend_ratio(const fs_wedge_model *w, const fs_wedge_snapsh
     const stresses st = {a->stress_top, b->stress_top, span > 0.0 ? (t - a->time) / span : 1.0};
     double best = -INFINITY, bound = -INFINITY;
     for (int32_t k = 0; k < w->n_tips; k++)
-        best = fmax(best, tip_ratio_of(w, &st, w->tip_node[k], NULL));
+        best = fmax(best, tip_ratio_of(w, &st, w->tip_node[k], NULL) * w->tip_scale[k]);
     uint8_t *open = open_nodes(w);
     for (int32_t i = 0; i < w->n_nodes; i++) {
         if (open[i])
@@ -295,6 +300,7 @@ static void tip_remove(fs_wedge_model *w, int32_t node)
     w->n_tips--;
     memmove(w->tip_node + k, w->tip_node + k + 1, (size_t)(w->n_tips - k) * sizeof *w->tip_node);
     memmove(w->tip_dir + 3 * k, w->tip_dir + 3 * (k + 1), 3 * (size_t)(w->n_tips - k) * sizeof *w->tip_dir);
+    memmove(w->tip_scale + k, w->tip_scale + k + 1, (size_t)(w->n_tips - k) * sizeof *w->tip_scale);
 }
 
 static void tip_add(fs_wedge_model *w, int32_t node, const double dir[3])
@@ -305,8 +311,10 @@ static void tip_add(fs_wedge_model *w, int32_t node, const double dir[3])
         w->cap_tips = w->cap_tips ? 2 * w->cap_tips : 16;
         w->tip_node = fs_realloc(w->tip_node, (size_t)w->cap_tips * sizeof *w->tip_node);
         w->tip_dir = fs_realloc(w->tip_dir, 3 * (size_t)w->cap_tips * sizeof *w->tip_dir);
+        w->tip_scale = fs_realloc(w->tip_scale, (size_t)w->cap_tips * sizeof *w->tip_scale);
     }
     w->tip_node[w->n_tips] = node;
+    w->tip_scale[w->n_tips] = 1.0;
     memcpy(w->tip_dir + 3 * (size_t)w->n_tips, dir, 3 * sizeof *dir);
     w->n_tips++;
 }
@@ -791,6 +799,22 @@ fail:
     return -1;
 }
 
+/* Angle-based smoothing (§5.7.9, fs_wedge_smooth) around the tips the cut made (the far ends that
+ * are still tips), when mesh.smooth_radius is set. Returns 0 or -1. */
+static int smooth_new_tips(fs_wedge_model *w, const int32_t ends[2], int n_rays)
+{
+    if (!(w->cfg.mesh.smooth_radius > 0.0))
+        return 0;
+    int32_t centres[2], n = 0;
+    for (int r = 0; r < n_rays; r++)
+        if (ends[r] >= 0 && tip_find(w, ends[r]) >= 0)
+            centres[n++] = ends[r];
+    if (n == 0)
+        return 0;
+    double radius = w->cfg.mesh.smooth_radius * fs_wedge_tips_unit(w);
+    return fs_wedge_smooth(w, centres, n, radius, w->cfg.mesh.smooth_iterations, NULL);
+}
+
 /* The in-plane crack direction at node n from the fracture plane normal m (3-D). */
 static bool crack_direction(const fs_wedge_model *w, int32_t n, const double m[3], double dir[3])
 {
@@ -804,28 +828,91 @@ static bool crack_direction(const fs_wedge_model *w, int32_t n, const double m[3
     return true;
 }
 
+/* The tip with the largest (scaled) ratio over 1, skipping those flagged in tried (may be NULL); -1
+ * if none. */
+static int32_t pick_tip(const fs_wedge_model *w, const uint8_t *tried)
+{
+    if (w->n_tips == 0)
+        return -1;
+    double *r = fs_malloc((size_t)w->n_tips * sizeof *r);
+    uint64_t *id = fs_malloc((size_t)w->n_tips * sizeof *id);
+    for (int32_t k = 0; k < w->n_tips; k++) {
+        r[k] = tip_ratio(w, w->tip_node[k], NULL) * w->tip_scale[k];
+        if (!(r[k] > 1.0) || (tried && tried[k]))
+            r[k] = NAN;
+        id[k] = (uint64_t)w->tip_node[k];
+    }
+    int32_t k = fs_rank_pick(r, id, w->n_tips, w->cfg.preset.seed);
+    free(r);
+    free(id);
+    return k;
+}
+
+/* design: thesis §5.7.8 in the event loop. A sub-model costs a small assembly, factorization and
+ * solve, so it is spent where the decision is made: the coarse estimate (tip_ratio, times the tip's
+ * scale) ranks the tips and drives the search in time, and only the tip about to extend gets a
+ * sub-model, whose nodal stress decides whether it extends (its over-threshold check) and where to
+ * (its direction). The tip's scale becomes the sub-model ratio over its coarse ratio, so the estimate
+ * of that tip agrees with the sub-model at this state and follows the coarse one as the load changes:
+ * a tip the sub-model finds below its threshold drops below 1, the next tip is tried, and the search
+ * in time finds when the scaled estimate crosses 1 again, where the sub-model checks once more (a
+ * secant-like iteration on the tip's true ratio). A tip the sub-model finds without tension gets
+ * scale 0 and no longer extends. An extended tip's new tip inherits the scale (the same crack, the
+ * same kind of concentration); a new crack's tips start at 1. */
+static int tip_submodel_check(fs_wedge_model *w, int32_t k, double *ratio, double m[3])
+{
+    int32_t node = w->tip_node[k];
+    double unit = fs_wedge_tips_unit(w);
+    if (fs_wedge_tip_submodel(w, node, w->cfg.fracture.tip_submodel_radius * unit,
+                              w->cfg.fracture.tip_submodel_size * unit, ratio, m, NULL) < 0)
+        return -1;
+    double coarse = tip_ratio(w, node, NULL);
+    w->tip_scale[k] = *ratio > 0.0 && coarse > 0.0 ? *ratio / coarse : 0.0;
+    return 0;
+}
+
 int fs_wedge_split_event(fs_wedge_model *w, int *changed)
 {
     *changed = 0;
     /* tips first (Fig. 5.20) */
     int32_t pick = -1;
-    bool from_tip = false;
-    if (w->n_tips > 0) {
-        double *r = fs_malloc((size_t)w->n_tips * sizeof *r);
-        uint64_t *id = fs_malloc((size_t)w->n_tips * sizeof *id);
-        for (int32_t k = 0; k < w->n_tips; k++) {
-            r[k] = tip_ratio(w, w->tip_node[k], NULL);
-            if (!(r[k] > 1.0))
-                r[k] = NAN;
-            id[k] = (uint64_t)w->tip_node[k];
-        }
-        int32_t k = fs_rank_pick(r, id, w->n_tips, w->cfg.preset.seed);
+    bool from_tip = false, have_m = false;
+    double m[3], scale = 1.0;
+    if (!w->cfg.fracture.tip_submodel) {
+        int32_t k = pick_tip(w, NULL);
         if (k >= 0) {
             pick = w->tip_node[k];
             from_tip = true;
         }
-        free(r);
-        free(id);
+    } else {
+        uint8_t *tried = fs_calloc((size_t)w->n_tips + 1, 1);
+        for (int32_t k; (k = pick_tip(w, tried)) >= 0;) {
+            /* §5.7.6 first, so the sub-model starts from the finer layer */
+            int32_t bisected = 0;
+            if (subdivide_around(w, w->tip_node[k], &bisected) < 0) {
+                free(tried);
+                return -1;
+            }
+            if (bisected > 0) {
+                free(tried);
+                *changed = 1;
+                return fs_wedge_equilibrium(w, w->time) < 0 ? -1 : 0;
+            }
+            double sub;
+            if (tip_submodel_check(w, k, &sub, m) < 0) {
+                free(tried);
+                return -1;
+            }
+            if (sub > 1.0) {
+                pick = w->tip_node[k];
+                from_tip = have_m = true;
+                scale = w->tip_scale[k];
+                break;
+            }
+            tried[k] = 1;
+            w->counters.submodel_rejections++;
+        }
+        free(tried);
     }
     if (pick < 0) {
         uint8_t *open = open_nodes(w);
@@ -851,11 +938,13 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed)
         return fs_wedge_equilibrium(w, w->time) < 0 ? -1 : 0;
     }
 
-    double m[3], dir[3], rays[2][3];
-    if (from_tip)
-        tip_ratio(w, pick, m);
-    else
-        node_ratio(w, pick, m);
+    double dir[3], rays[2][3];
+    if (!have_m) {
+        if (from_tip)
+            tip_ratio(w, pick, m);
+        else
+            node_ratio(w, pick, m);
+    }
     if (!crack_direction(w, pick, m, dir)) {
         tip_remove(w, pick);
         return 0;
@@ -896,6 +985,8 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed)
     }
     *changed = 1;
     w->fractures++;
+    if (from_tip && tip_find(w, ends[0]) >= 0)
+        w->tip_scale[tip_find(w, ends[0])] = scale;
     if (griffith) {
         bool local = w->cfg.solver.relax == FS_RELAX_LOCAL;
         if ((local ? fs_wedge_relax(w, NULL, 0) : fs_wedge_equilibrium(w, w->time)) < 0) {
@@ -910,5 +1001,5 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed)
         }
     }
     free(region.v);
-    return 0;
+    return smooth_new_tips(w, ends, n_rays);
 }

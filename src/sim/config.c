@@ -20,6 +20,10 @@ fs_config fs_config_default(void)
     c.mesh.lattice = FS_LATTICE_RANDOM;
     c.mesh.relax_iterations = 30;
     c.mesh.radius_jitter = 0.2;
+    c.mesh.refine_vm = 0.0;
+    c.mesh.refine_vm_rounds = 3;
+    c.mesh.smooth_radius = 0.0;
+    c.mesh.smooth_iterations = 3;
 
     c.material = fs_material_default();
     c.growth = fs_growth_default();
@@ -27,6 +31,9 @@ fs_config fs_config_default(void)
 
     c.fracture.method = FS_FRACTURE_SPLIT;
     c.fracture.griffith = true;
+    c.fracture.tip_submodel = false;
+    c.fracture.tip_submodel_radius = 4.0;
+    c.fracture.tip_submodel_size = 0.25;
 
     c.time.end = 1.0;
     c.time.min_step = 1e-4;

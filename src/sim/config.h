@@ -28,11 +28,24 @@ typedef struct {
     fs_lattice lattice;     /* random (particle repulsion) or hexagonal lattice */
     int relax_iterations;   /* particle repulsion iterations */
     double radius_jitter;   /* random perturbation of the repulsion radii (relative) */
+    double refine_vm;       /* wedge: adaptive refinement by von Mises discontinuity (thesis §5.7.7,
+                               Algorithm 13) at every new time step: the threshold of a node's
+                               (max - min von Mises of its elements) / largest principal stress;
+                               0 = off */
+    int refine_vm_rounds;   /* wedge: refinement rounds (subdivide once, re-solve) per time step */
+    double smooth_radius;   /* wedge, split: angle-based smoothing of the nodes within this many mean
+                               edge lengths of every new crack tip (thesis §5.7.9); 0 = off */
+    int smooth_iterations;  /* wedge, split: smoothing sweeps over those nodes per new tip */
 } fs_mesh_params;
 
 typedef struct {
     fs_fracture_method method;
     bool griffith;          /* stop cracks by the Griffith energy criterion */
+    bool tip_submodel;      /* split: the stress of the tip about to extend from a refined local
+                               sub-model (thesis §5.7.8) instead of the coarse estimate */
+    double tip_submodel_radius; /* its radius, in mean edge lengths */
+    double tip_submodel_size;   /* the size (longest edge) it refines the tip's vicinity to, in mean
+                                   edge lengths */
 } fs_fracture_params;
 
 typedef struct {
