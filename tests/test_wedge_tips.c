@@ -220,7 +220,8 @@ static double max_residual(const fs_wedge_model *w, double *tau)
             int32_t i = k->row_idx[p];
             double v = k->values[p];
             if (j >= nf) {
-                f[i] -= v * w->u_fixed[j - nf];
+                if (i < nf) /* not the fixed column's own (zero) diagonal */
+                    f[i] -= v * w->u_fixed[j - nf];
             } else {
                 ku[i] += v * x[j];
                 if (i != j)

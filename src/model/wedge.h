@@ -146,7 +146,8 @@ typedef struct {
     int32_t *fixed_node_dof;     /* n_fixed: the node DOF (6 i + k) of each fixed index */
     fs_sparse_matrix k_all;      /* upper CSC of order n_free + n_fixed: the free-free block in the
                                     leading columns, the free-fixed coupling in the others (no
-                                    fixed-fixed entries) */
+                                    fixed-fixed entries but each fixed column's own
+                                    zero diagonal) */
     size_t k_all_capacity;       /* entries k_all's row and value arrays have room for (they grow
                                     geometrically as the mesh is cut, see extend_system) */
     fs_sparse_matrix k_free;     /* a view of k_all's leading n_free columns (shares its arrays) */

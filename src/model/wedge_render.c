@@ -551,7 +551,8 @@ static int32_t points_on_edge(const render_ctx *r, const group_grid *g, const do
                 (*found)[n++] = (on_edge){t, grp};
             }
         }
-    qsort(*found, (size_t)n, sizeof **found, cmp_on_edge);
+    if (n > 1)
+        qsort(*found, (size_t)n, sizeof **found, cmp_on_edge);
     return n;
 }
 
