@@ -683,6 +683,43 @@ static void assemble_coupled(int32_t m, const double c[9], fs_sparse_matrix *a)
 
 /* The 3x3 block preconditioner solves to the same tolerance in fewer iterations than Jacobi when the
  * three unknowns of a point are coupled, and reports a block that is not positive definite. */
+/* The max_residual rule stops once no entry of b - A x exceeds the bound, and sooner than the
+ * Euclidean rule with the same bound on the whole vector. */
+static void test_cg_max_residual(void)
+{
+    enum { m = 20, n = 3 * m * m };
+    const double c[9] = {4, 3, 2, 3, 4, 3, 2, 3, 4};
+    fs_sparse_matrix a;
+    assemble_coupled(m, c, &a);
+    double *b = random_vector(n, 23);
+    double *x = calloc(n, sizeof *x), *ax = calloc(n, sizeof *ax);
+    double bmax = 0.0, b2 = 0.0;
+    for (int i = 0; i < n; i++) {
+        bmax = fmax(bmax, fabs(b[i]));
+        b2 += b[i] * b[i];
+    }
+    double bound = 1e-4 * bmax;
+    fs_cg_params params = fs_cg_params_default();
+    params.block = 3;
+    params.max_residual = bound;
+    int by_max = fs_cg_solve(&a, b, x, params, NULL);
+    fs_sparse_matvec(&a, x, ax);
+    double worst = 0.0;
+    for (int i = 0; i < n; i++)
+        worst = fmax(worst, fabs(b[i] - ax[i]));
+    CHECK_MSG(by_max > 0 && worst <= bound, "%d iterations, largest residual %g > %g", by_max, worst, bound);
+    for (int i = 0; i < n; i++)
+        x[i] = 0.0;
+    params.max_residual = 0.0;
+    params.tolerance = bound / sqrt(b2);
+    int by_norm = fs_cg_solve(&a, b, x, params, NULL);
+    CHECK_MSG(by_norm > by_max, "Euclidean rule %d iterations, max rule %d", by_norm, by_max);
+    fs_sparse_matrix_free(&a);
+    free(b);
+    free(x);
+    free(ax);
+}
+
 static void test_cg_block_preconditioner(void)
 {
     enum { m = 20, n = 3 * m * m };
@@ -728,5 +765,6 @@ int main(void)
     RUN(test_cg_agrees_with_cholesky);
     RUN(test_cg_reports_failures);
     RUN(test_cg_block_preconditioner);
+    RUN(test_cg_max_residual);
     return check_finish();
 }

@@ -69,6 +69,7 @@ typedef struct {
     int64_t global_fallbacks;  /* fs_wedge_relax calls that needed a global solve */
     int64_t relax_retries;     /* local relaxations repeated at a doubled radius within one call */
     int64_t local_dofs;        /* unknowns of the local systems, summed over fs_wedge_relax calls */
+    int64_t local_cg_iterations; /* CG iterations of the local systems */
     double local_seconds;      /* time in fs_wedge_relax, global fallbacks included */
     int64_t time_steps;        /* event searches (advances of time, Algorithm 5) */
     int64_t search_evaluations; /* their exact and estimated evaluations (fracture/event.h) */

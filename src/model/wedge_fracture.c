@@ -211,9 +211,10 @@ int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, f
                  (long long)w.counters.local_relaxations, (long long)w.counters.global_fallbacks);
         double per = c->event_relaxations ? 1e3 / (double)c->event_relaxations : 0.0;
         fs_debug("wedge: %lld time steps, %lld event-search evaluations; %lld events with relaxation, %.2f ms each "
-                 "(%.2f ms relaxing); local relaxation %.2f s, %lld unknowns, %lld retries", (long long)c->time_steps,
-                 (long long)c->search_evaluations, (long long)c->event_relaxations, per * c->event_seconds,
-                 per * c->event_relax_seconds, c->local_seconds, (long long)c->local_dofs, (long long)c->relax_retries);
+                 "(%.2f ms relaxing); local relaxation %.2f s, %lld unknowns, %lld CG iterations, %lld retries",
+                 (long long)c->time_steps, (long long)c->search_evaluations, (long long)c->event_relaxations,
+                 per * c->event_seconds, per * c->event_relax_seconds, c->local_seconds, (long long)c->local_dofs,
+                 (long long)c->local_cg_iterations, (long long)c->relax_retries);
         fs_debug("wedge: %lld removals, %lld subdivisions, %lld solves (%.2f s), %lld factorizations (%.2f s), "
                  "%lld analyses (%.2f s), %lld updates (%.2f s), assembly %.2f s, stresses %.2f s, "
                  "%lld CG iterations",

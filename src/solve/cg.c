@@ -2,6 +2,7 @@
 #include "solve/cg.h"
 
 #include <math.h>
+#include <stdbool.h>
 
 #include "base/error.h"
 
@@ -11,6 +12,7 @@ fs_cg_params fs_cg_params_default(void)
     params.tolerance = 1e-8;
     params.max_iterations = 0;
     params.block = 1;
+    params.max_residual = 0.0;
     return params;
 }
 
@@ -20,6 +22,14 @@ static double dot(int32_t n, const double *u, const double *v)
     for (int32_t i = 0; i < n; i++)
         s += u[i] * v[i];
     return s;
+}
+
+static double max_abs(int32_t n, const double *v)
+{
+    double m = 0.0;
+    for (int32_t i = 0; i < n; i++)
+        m = fmax(m, fabs(v[i]));
+    return m;
 }
 
 /* r = b - A x, using q as scratch; returns ||r||. */
@@ -124,10 +134,13 @@ int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_par
     if (preconditioner(a, block, inv) < 0)
         goto done;
 
+    /* converged: the Euclidean norm rnorm within limit, or with a max_residual, every entry of r */
+    bool by_max = params.max_residual > 0.0;
     double limit = params.tolerance * bnorm;
+#define CONVERGED() (by_max ? max_abs(n, r) <= params.max_residual : rnorm <= limit)
     double rnorm = true_residual(a, b, x, r, q);
     int32_t iterations = 0;
-    if (rnorm > limit) {
+    if (!CONVERGED()) {
         double rz = precondition(n, block, inv, r, z);
         for (int32_t i = 0; i < n; i++)
             p[i] = z[i];
@@ -146,9 +159,9 @@ int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_par
             }
             iterations++;
             rnorm = sqrt(dot(n, r, r));
-            if (rnorm <= limit) {
+            if (CONVERGED()) {
                 rnorm = true_residual(a, b, x, r, q);
-                if (rnorm <= limit)
+                if (CONVERGED())
                     break;
                 rz = precondition(n, block, inv, r, z);
                 for (int32_t i = 0; i < n; i++)
@@ -164,11 +177,12 @@ int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_par
     }
     if (relative_residual)
         *relative_residual = rnorm / bnorm;
-    if (rnorm > limit) {
+    if (!CONVERGED()) {
         fs_error(FS_ERR_INTERNAL, "cg: no convergence after %d iterations (relative residual %.3g)", iterations,
                  rnorm / bnorm);
         goto done;
     }
+#undef CONVERGED
     status = iterations;
 done:
     free(scratch);

@@ -13,16 +13,19 @@ typedef struct {
     int32_t block;          /* 1: Jacobi (diagonal) preconditioner; 3: the inverses of the 3x3 diagonal
                                blocks of unknowns 3k .. 3k + 2 (a node's displacement: n must be a
                                multiple of 3), which converges in fewer iterations for elasticity */
+    double max_residual;    /* > 0: stop instead when no entry of b - A x exceeds this in magnitude
+                               (the tolerance is then unused) */
 } fs_cg_params;
 
-/* tolerance 1e-8, max_iterations 0 (that is, n), block 1. */
+/* tolerance 1e-8, max_iterations 0 (that is, n), block 1, max_residual 0. */
 fs_cg_params fs_cg_params_default(void);
 
 /* Solves A x = b for the symmetric positive definite matrix whose upper triangle a stores, by conjugate
  * gradients preconditioned with diag(A) or its 3x3 diagonal blocks (params.block). x holds the starting guess on entry (zeros, or the previous
  * step's solution) and the solution on return; b and x have a->n elements and must not overlap.
  * Convergence is judged on the true residual, recomputed when the recurrence claims convergence. If
- * relative_residual is not NULL it receives the final ||b - A x|| / ||b||. Scratch memory (4n doubles) is
+ * relative_residual is not NULL it receives the final ||b - A x|| / ||b|| (Euclidean norms, also when
+ * params.max_residual is the rule). Scratch memory (4n doubles) is
  * allocated per call. Returns the number of iterations (0 if the guess already satisfies the tolerance;
  * x = 0 if b = 0), or -1 with FS_ERR_INTERNAL: "cg: no convergence after N iterations (relative residual
  * r)", or when a diagonal entry or block, or a curvature p'Ap is not positive (A is not positive definite). */
