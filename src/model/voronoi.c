@@ -9,6 +9,7 @@
 #include "base/rng.h"
 #include "base/vec.h"
 #include "field/noise.h"
+#include "render/sphere.h"
 
 /* design: a cell is the polygon of the circumcentres of its node's ring, brought into the node's
  * frame (plane, cylinder) with the corner shifts; an open ring (a node on the convex hull of a
@@ -27,11 +28,9 @@
  * zipping its two legs, so the render mesh is conforming: it has no cracks of its own at any
  * resolution. Border segments of a clipped cell continue the distance of the Voronoi segment next
  * to them (zone_polyline).
- *   Sphere: the bands are built on the chords in 3-D and refined edge by edge until the
- * equirectangular map is close to affine on each piece (refine_sphere, still conforming); each
- * triangle's u values are unwrapped around its first vertex, and a triangle containing a pole is
- * split at the pole into three whose images are columns of meridian segments reaching the pole's
- * row of the texture. */
+ *   Sphere: the bands are built on the chords in 3-D and drawn by fs_sphere_triangle
+ * (render/sphere.h), which refines them edge by edge until the equirectangular map is close to
+ * affine on each piece, still conforming, and cuts a triangle containing a pole at the pole. */
 
 fs_voronoi_params fs_voronoi_params_default(void)
 {
@@ -50,10 +49,8 @@ enum { SEG_BORDER = 0, SEG_CRACK = 1 };
 enum { BAND_CRACK = 0, BAND_BEVEL = 1, BAND_TOP = 2 };
 
 /* Sphere refinement: largest uv deviation of a chord's image from the straight line before the
- * chord is halved, shortest chord halved (in radii), and a bound on the depth of halving. */
+ * chord is halved (render/sphere.h). */
 #define SPHERE_UV_TOLERANCE 2e-4
-#define SPHERE_MIN_EDGE 1e-3
-#define SPHERE_MAX_DEPTH 24
 
 /* Vertex attributes of the render mesh besides the position. */
 typedef struct {
@@ -94,8 +91,8 @@ typedef struct {
     double noise_scale[2]; /* domain coordinate -> noise lattice coordinate */
     uint64_t warp_seed[3]; /* one noise channel per displacement component */
     double half_width, rim;
-    double pole[2][3];     /* unit vectors to the poles (sphere) */
-    double pole_v[2];      /* their v in texture space */
+    fs_sphere_refiner sphere_refiner; /* sphere: draws the band triangles */
+    const band_vertex *sphere_corner[3]; /* the band triangle it draws */
     polygon cell, clipped, line, zoned;
     double *line_apex;     /* per segment of line: distance of the site from its line */
     int *zone_src;         /* per segment of zoned: the segment of line whose distance it uses, or -1 */
@@ -137,17 +134,6 @@ static bool lex_less(const double *a, const double *b)
     return false;
 }
 
-static attr attr_lerp(attr a, attr b, double t)
-{
-    attr r = {
-        a.height + (b.height - a.height) * t,
-        a.crack + (b.crack - a.crack) * t,
-        a.cell + (b.cell - a.cell) * t,
-        a.shade + (b.shade - a.shade) * t,
-    };
-    return r;
-}
-
 /* a + (b - a) wb + (c - a) wc */
 static attr attr_bary(attr a, attr b, attr c, double wb, double wc)
 {
@@ -176,8 +162,6 @@ static void project_sphere(double radius, double *p)
             p[k] *= radius / r;
 }
 
-/* u moved by a whole number of periods into [ref - 0.5, ref + 0.5). */
-static double unwrap_near(double u, double ref) { return u - floor(u - ref + 0.5); }
 
 /* ---- warp ---- */
 
@@ -370,232 +354,30 @@ static void band_tri_add(ctx *c, int a, int b, int d)
     c->bt[c->n_bt++] = d;
 }
 
-static void sphere_uv(const ctx *c, const double *p, double *uv)
-{
-    double q[3] = {p[0], p[1], p[2]};
-    project_sphere(c->m->domain.radius, q);
-    fs_domain_to_uv(&c->m->domain, q, uv);
-}
-
 static void add_vertex(ctx *c, double u, double v, attr a)
 {
     fs_render_mesh_add_vertex(c->out, u, v, a.height, a.crack, a.cell, a.shade);
 }
 
-static band_vertex midpoint(const band_vertex *a, const band_vertex *b)
+/* fs_sphere_refiner.vertex: a vertex with the attributes of the band triangle's corners mixed by w. */
+static int32_t sphere_vertex(void *user, double u, double v, const double w[3])
 {
-    band_vertex m;
-    for (int q = 0; q < 3; q++)
-        m.p[q] = 0.5 * (a->p[q] + b->p[q]);
-    m.a = attr_lerp(a->a, b->a, 0.5);
-    return m;
-}
-
-/* Whether the chord pq is cut in two before mapping: the map to texture space is too far from
- * affine along it. A function of the unordered pair only, so neighbours agree. */
-static bool sphere_split_edge(const ctx *c, const double *p, const double *q)
-{
-    if (lex_less(q, p)) {
-        const double *t = p;
-        p = q;
-        q = t;
-    }
-    double d[3];
-    fs_sub3(d, q, p);
-    if (fs_norm3(d) <= SPHERE_MIN_EDGE * c->m->domain.radius)
-        return false;
-    double mid[3] = {0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]), 0.5 * (p[2] + q[2])};
-    double up[2], uq[2], um[2];
-    sphere_uv(c, p, up);
-    sphere_uv(c, q, uq);
-    sphere_uv(c, mid, um);
-    uq[0] = unwrap_near(uq[0], up[0]);
-    um[0] = unwrap_near(um[0], up[0]);
-    /* near the poles the map is so anisotropic that thin pieces would flip: be stricter there */
-    double near_pole = fmax(fabs(um[1] - 0.5) * 2.0 - 0.85, 0.0) / 0.15;
-    double tol = SPHERE_UV_TOLERANCE * (1.0 - 0.75 * near_pole);
-    return hypot(um[0] - 0.5 * (up[0] + uq[0]), um[1] - 0.5 * (up[1] + uq[1])) > tol;
-}
-
-/* One triangle of the sphere whose u values are unwrapped around its first vertex. */
-static void emit_sphere_leaf(ctx *c, const band_vertex *va, const band_vertex *vb, const band_vertex *vc)
-{
-    const band_vertex *v[3] = {va, vb, vc};
-    int32_t base = c->out->n_verts;
-    double u0 = 0.0;
-    for (int k = 0; k < 3; k++) {
-        double uv[2];
-        sphere_uv(c, v[k]->p, uv);
-        if (k == 0)
-            u0 = uv[0];
-        add_vertex(c, unwrap_near(uv[0], u0), uv[1], v[k]->a);
-    }
-    fs_render_mesh_add_tri(c->out, base, base + 1, base + 2);
-}
-
-/* design: edge-based refinement. Each edge is halved when sphere_split_edge says so, and a triangle
- * is cut into 2, 3 or 4 according to how many of its edges are halved; children repeat the test.
- * Since the decision and the midpoint depend only on the edge, both triangles of an edge cut it
- * at the same points and the refined mesh stays conforming. */
-static void refine_sphere(ctx *c, const band_vertex *a, const band_vertex *b, const band_vertex *d, int depth)
-{
-    const band_vertex *v[3] = {a, b, d};
-    bool split[3];
-    int n = 0;
-    for (int k = 0; k < 3; k++) {
-        split[k] = depth < SPHERE_MAX_DEPTH && sphere_split_edge(c, v[k]->p, v[(k + 1) % 3]->p);
-        n += split[k];
-    }
-    if (n == 0) {
-        emit_sphere_leaf(c, a, b, d);
-        return;
-    }
-    band_vertex mid[3];
-    for (int k = 0; k < 3; k++)
-        if (split[k])
-            mid[k] = midpoint(v[k], v[(k + 1) % 3]);
-    if (n == 3) {
-        refine_sphere(c, a, &mid[0], &mid[2], depth + 1);
-        refine_sphere(c, &mid[0], b, &mid[1], depth + 1);
-        refine_sphere(c, &mid[2], &mid[1], d, depth + 1);
-        refine_sphere(c, &mid[0], &mid[1], &mid[2], depth + 1);
-        return;
-    }
-    if (n == 1) {
-        int k = split[0] ? 0 : (split[1] ? 1 : 2);
-        refine_sphere(c, v[k], &mid[k], v[(k + 2) % 3], depth + 1);
-        refine_sphere(c, &mid[k], v[(k + 1) % 3], v[(k + 2) % 3], depth + 1);
-        return;
-    }
-    int k = !split[0] ? 0 : (!split[1] ? 1 : 2), k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-    refine_sphere(c, &mid[k1], v[k2], &mid[k2], depth + 1);
-    refine_sphere(c, v[k], v[k1], &mid[k1], depth + 1);
-    refine_sphere(c, v[k], &mid[k1], &mid[k2], depth + 1);
-}
-
-/* The points of chord ab as refine_sphere cuts it, from a up to but excluding b. */
-static void edge_points(ctx *c, const band_vertex *a, const band_vertex *b, int depth, band_vertex **list, int *n,
-                        int *cap)
-{
-    if (depth < SPHERE_MAX_DEPTH && sphere_split_edge(c, a->p, b->p)) {
-        band_vertex m = midpoint(a, b);
-        edge_points(c, a, &m, depth + 1, list, n, cap);
-        edge_points(c, &m, b, depth + 1, list, n, cap);
-        return;
-    }
-    if (*n == *cap) {
-        *cap = *cap ? 2 * *cap : 32;
-        *list = fs_realloc(*list, (size_t)*cap * sizeof **list);
-    }
-    (*list)[(*n)++] = *a;
-}
-
-/* Triangle (X, A, B) with X on the ray to pole k: columns of meridian segments from the points of
- * the chord AB (cut as its neighbour across AB cuts it) to the pole's row. Seen from outside,
- * counter-clockwise about the north pole means increasing longitude, about the south pole
- * decreasing. */
-static void emit_sphere_pole(ctx *c, int k, const band_vertex *x, const band_vertex *va, const band_vertex *vb)
-{
-    const int rows = 4;
-    bool north = c->pole_v[k] > 0.5;
-    band_vertex *col = NULL;
-    int ncol = 0, cap = 0;
-    edge_points(c, va, vb, 0, &col, &ncol, &cap);
-    if (ncol == cap) {
-        cap++;
-        col = fs_realloc(col, (size_t)cap * sizeof *col);
-    }
-    col[ncol++] = *vb;
-    int32_t base = c->out->n_verts;
-    double u_prev = 0.0;
-    for (int j = 0; j < ncol; j++) {
-        double uv[2];
-        sphere_uv(c, col[j].p, uv);
-        double u = uv[0];
-        if (j > 0) {
-            double step = north ? u - u_prev : u_prev - u;
-            step -= floor(step);
-            if (step > 1.0 - 1e-9)
-                step = 0.0;
-            u = north ? u_prev + step : u_prev - step;
-        }
-        u_prev = u;
-        for (int r = 0; r <= rows; r++) {
-            double s = (double)r / rows, p[3];
-            for (int q = 0; q < 3; q++)
-                p[q] = col[j].p[q] + (x->p[q] - col[j].p[q]) * s;
-            if (r == rows)
-                uv[1] = c->pole_v[k];
-            else
-                sphere_uv(c, p, uv);
-            add_vertex(c, u, uv[1], attr_lerp(col[j].a, x->a, s));
-        }
-    }
-    for (int j = 0; j + 1 < ncol; j++)
-        for (int r = 0; r < rows; r++) {
-            int32_t v00 = base + j * (rows + 1) + r, v10 = v00 + rows + 1;
-            fs_render_mesh_add_tri(c->out, v00, v10, v10 + 1);
-            fs_render_mesh_add_tri(c->out, v00, v10 + 1, v00 + 1);
-        }
-    free(col);
-}
-
-/* A band triangle of the sphere: split at a pole it contains, else refined until the map to
- * texture space is nearly affine on each piece. */
-static void emit_sphere_tri(ctx *c, const band_vertex *va, const band_vertex *vb, const band_vertex *vc)
-{
-    const double *a = va->p, *b = vb->p, *d = vc->p;
-    double ab[3], ad[3], n[3];
-    fs_sub3(ab, b, a);
-    fs_sub3(ad, d, a);
-    fs_cross3(n, ab, ad);
-    double nn = fs_dot3(n, n);
-    if (nn == 0.0)
-        return;
-    for (int k = 0; k < 2; k++) {
-        const double *pole = c->pole[k];
-        double sum[3] = {a[0] + b[0] + d[0], a[1] + b[1] + d[1], a[2] + b[2] + d[2]}, e[3];
-        if (fs_dot3(pole, sum) <= 0.0)
-            continue;
-        fs_cross3(e, a, b);
-        if (fs_dot3(pole, e) < 0.0)
-            continue;
-        fs_cross3(e, b, d);
-        if (fs_dot3(pole, e) < 0.0)
-            continue;
-        fs_cross3(e, d, a);
-        if (fs_dot3(pole, e) < 0.0)
-            continue;
-        double np = fs_dot3(n, pole);
-        if (np <= 0.0)
-            continue;
-        band_vertex x;
-        double s = fs_dot3(n, a) / np, xb[3], xd[3], cr[3];
-        for (int q = 0; q < 3; q++)
-            x.p[q] = pole[q] * s;
-        fs_sub3(xb, b, x.p);
-        fs_sub3(xd, d, x.p);
-        fs_cross3(cr, xb, xd);
-        double la = fs_dot3(n, cr) / nn;
-        fs_sub3(xb, d, x.p);
-        fs_sub3(xd, a, x.p);
-        fs_cross3(cr, xb, xd);
-        double lb = fs_dot3(n, cr) / nn;
-        x.a = attr_bary(va->a, vb->a, vc->a, lb, 1.0 - la - lb);
-        emit_sphere_pole(c, k, &x, va, vb);
-        emit_sphere_pole(c, k, &x, vb, vc);
-        emit_sphere_pole(c, k, &x, vc, va);
-        return;
-    }
-    refine_sphere(c, va, vb, vc, 0);
+    ctx *c = user;
+    const band_vertex *const *t = c->sphere_corner;
+    attr a = attr_bary(t[0]->a, t[1]->a, t[2]->a, w[1], w[2]);
+    return fs_render_mesh_add_vertex(c->out, u, v, a.height, a.crack, a.cell, a.shade);
 }
 
 /* Sends the collected band vertices and triangles to the render mesh. */
 static void flush_band(ctx *c)
 {
     if (c->sphere) {
-        for (int k = 0; k < c->n_bt; k += 3)
-            emit_sphere_tri(c, c->bv + c->bt[k], c->bv + c->bt[k + 1], c->bv + c->bt[k + 2]);
+        for (int k = 0; k < c->n_bt; k += 3) {
+            for (int j = 0; j < 3; j++)
+                c->sphere_corner[j] = c->bv + c->bt[k + j];
+            fs_sphere_triangle(&c->sphere_refiner, c->sphere_corner[0]->p, c->sphere_corner[1]->p,
+                               c->sphere_corner[2]->p);
+        }
     } else {
         int32_t base = c->out->n_verts;
         for (int k = 0; k < c->n_bv; k++)
@@ -951,16 +733,7 @@ int fs_voronoi_render_mesh(const fs_mesh *m, const fs_voronoi_params *p, uint64_
         c.warp_seed[k] = fs_hash3(seed, FS_RNG_NOISE, UINT64_MAX - (uint64_t)k);
     c.half_width = 0.5 * p->crack_width;
     c.rim = p->depth > p->bevel ? p->depth - p->bevel : 0.0;
-    if (c.sphere) {
-        for (int k = 0; k < 2; k++) {
-            double uv[2] = {0.0, (double)k}, q[3];
-            fs_domain_from_uv(d, uv, q);
-            double r = fs_norm3(q);
-            for (int j = 0; j < 3; j++)
-                c.pole[k][j] = q[j] / r;
-            c.pole_v[k] = (double)k;
-        }
-    }
+    c.sphere_refiner = (fs_sphere_refiner){d, SPHERE_UV_TOLERANCE, out, sphere_vertex, &c};
 
     for (int32_t node = 0; node < m->n_nodes; node++) {
         if (!cell_polygon(&c, node))

@@ -8,11 +8,11 @@
 #include "base/rng.h"
 #include "base/vec.h"
 #include "model/wedge.h"
+#include "render/sphere.h"
 
-/* Sphere: largest uv deviation of a chord's midpoint image from the mean of its ends before a
- * triangle is split into four, and the depth limit of that splitting. */
+/* Sphere: largest uv deviation of a chord's midpoint image from the mean of its ends' images
+ * before the chord is halved (render/sphere.h). */
 #define SPHERE_UV_TOLERANCE 5e-4
-#define SPHERE_MAX_DEPTH 6
 
 static int32_t find_root(int32_t *parent, int32_t i)
 {
@@ -78,168 +78,6 @@ static int32_t add_vertex(fs_render_mesh *out, double u, double v, attr a)
     return fs_render_mesh_add_vertex(out, u, v, a.height, a.crack, a.cell, a.shade);
 }
 
-/* ---- sphere ---- */
-
-typedef struct {
-    const fs_domain *d;
-    fs_render_mesh *out;
-} sphere_ctx;
-
-static void sphere_uv(const sphere_ctx *s, const double *p, double uv[2])
-{
-    double q[3], r = fs_norm3(p);
-    for (int k = 0; k < 3; k++)
-        q[k] = p[k] * (s->d->radius / r);
-    fs_domain_to_uv(s->d, q, uv);
-}
-
-/* u of b brought within half a period of u of a. */
-static double unwrap_u(double ua, double ub)
-{
-    while (ub - ua > 0.5)
-        ub -= 1.0;
-    while (ub - ua < -0.5)
-        ub += 1.0;
-    return ub;
-}
-
-static void midpoint(const double *a, const double *b, double *m)
-{
-    for (int k = 0; k < 3; k++)
-        m[k] = 0.5 * (a[k] + b[k]);
-}
-
-static bool chord_bends(const sphere_ctx *s, const double *a, const double *b)
-{
-    double ua[2], ub[2], um[2], m[3];
-    midpoint(a, b, m);
-    sphere_uv(s, a, ua);
-    sphere_uv(s, b, ub);
-    sphere_uv(s, m, um);
-    ub[0] = unwrap_u(ua[0], ub[0]);
-    um[0] = unwrap_u(ua[0], um[0]);
-    return fabs(um[0] - 0.5 * (ua[0] + ub[0])) + fabs(um[1] - 0.5 * (ua[1] + ub[1])) > SPHERE_UV_TOLERANCE;
-}
-
-static void sphere_leaf(const sphere_ctx *s, const double p[3][3], const attr a[3])
-{
-    int32_t v[3];
-    double u0 = 0.0;
-    for (int c = 0; c < 3; c++) {
-        double uv[2];
-        sphere_uv(s, p[c], uv);
-        if (c == 0)
-            u0 = uv[0];
-        else
-            uv[0] = unwrap_u(u0, uv[0]);
-        v[c] = add_vertex(s->out, uv[0], uv[1], a[c]);
-    }
-    fs_render_mesh_add_tri(s->out, v[0], v[1], v[2]);
-}
-
-static void sphere_refine(const sphere_ctx *s, const double p[3][3], const attr a[3], int depth)
-{
-    bool split = false;
-    for (int c = 0; c < 3 && depth < SPHERE_MAX_DEPTH && !split; c++)
-        split = chord_bends(s, p[c], p[(c + 1) % 3]);
-    if (!split) {
-        sphere_leaf(s, p, a);
-        return;
-    }
-    double m[3][3];
-    attr am[3];
-    for (int c = 0; c < 3; c++) {
-        midpoint(p[c], p[(c + 1) % 3], m[c]);
-        am[c] = attr_mix(a[c], a[(c + 1) % 3], a[c], 0.5, 0.5, 0.0);
-    }
-    double q[3][3];
-    attr aq[3];
-    for (int c = 0; c < 3; c++) { /* corner triangles (p_c, m_c, m_c-1) */
-        memcpy(q[0], p[c], sizeof q[0]);
-        memcpy(q[1], m[c], sizeof q[1]);
-        memcpy(q[2], m[(c + 2) % 3], sizeof q[2]);
-        aq[0] = a[c];
-        aq[1] = am[c];
-        aq[2] = am[(c + 2) % 3];
-        sphere_refine(s, q, aq, depth + 1);
-    }
-    sphere_refine(s, m, am, depth + 1);
-}
-
-/* Triangle (pole, a, b): strips of meridians from points of the chord ab up to the pole's row of the
- * texture, carrying the pole's attributes there. */
-static void sphere_pole_wedge(const sphere_ctx *s, double pole_v, attr ap, const double *a, const double *b,
-                              attr aa, attr ab)
-{
-    double ua[2], ub[2];
-    sphere_uv(s, a, ua);
-    sphere_uv(s, b, ub);
-    double du = unwrap_u(ua[0], ub[0]) - ua[0];
-    int n = 1 + (int)ceil(fabs(du) * 128.0);
-    double prev_uv[2] = {ua[0], ua[1]};
-    attr prev = aa;
-    for (int k = 1; k <= n; k++) {
-        double t = (double)k / n, p[3], uv[2];
-        for (int c = 0; c < 3; c++)
-            p[c] = a[c] + t * (b[c] - a[c]);
-        sphere_uv(s, p, uv);
-        uv[0] = unwrap_u(prev_uv[0], uv[0]);
-        attr cur = attr_mix(aa, ab, aa, 1.0 - t, t, 0.0);
-        int32_t v0 = add_vertex(s->out, prev_uv[0], prev_uv[1], prev);
-        int32_t v1 = add_vertex(s->out, uv[0], uv[1], cur);
-        int32_t v2 = add_vertex(s->out, uv[0], pole_v, ap);
-        int32_t v3 = add_vertex(s->out, prev_uv[0], pole_v, ap);
-        fs_render_mesh_add_tri(s->out, v0, v1, v2);
-        fs_render_mesh_add_tri(s->out, v0, v2, v3);
-        prev_uv[0] = uv[0];
-        prev_uv[1] = uv[1];
-        prev = cur;
-    }
-}
-
-/* design: as in model/voronoi.c, a sphere triangle is drawn in the equirectangular texture with its u
- * values unwrapped around its first corner, split into four while the map bends its edges, and a
- * triangle around a pole is cut at the pole into three whose images are strips of meridians
- * reaching the pole's row. */
-static void sphere_triangle(const sphere_ctx *s, const double p[3][3], const attr a[3])
-{
-    for (int k = 0; k < 2; k++) {
-        double pole[3] = {0.0, 0.0, k ? s->d->radius : -s->d->radius};
-        double sum[3] = {0}, cr[3];
-        for (int c = 0; c < 3; c++)
-            for (int j = 0; j < 3; j++)
-                sum[j] += p[c][j];
-        if (fs_dot3(pole, sum) <= 0.0)
-            continue;
-        bool inside = true;
-        for (int c = 0; c < 3 && inside; c++) {
-            fs_cross3(cr, p[c], p[(c + 1) % 3]);
-            inside = fs_dot3(pole, cr) >= 0.0;
-        }
-        if (!inside)
-            continue;
-        /* the pole's attributes: barycentric weights of the pole's projection onto the flat triangle */
-        double e1[3], e2[3], n[3], q[3], w[3];
-        fs_sub3(e1, p[1], p[0]);
-        fs_sub3(e2, p[2], p[0]);
-        fs_cross3(n, e1, e2);
-        double nn = fs_dot3(n, n);
-        for (int c = 0; c < 3; c++) {
-            double x[3], y[3];
-            fs_sub3(x, p[(c + 1) % 3], pole);
-            fs_sub3(y, p[(c + 2) % 3], pole);
-            fs_cross3(q, x, y);
-            w[c] = fs_dot3(q, n) / nn;
-        }
-        attr ap = attr_mix(a[0], a[1], a[2], w[0], w[1], w[2]);
-        double pole_v = k ? 1.0 : 0.0;
-        for (int c = 0; c < 3; c++)
-            sphere_pole_wedge(s, pole_v, ap, p[c], p[(c + 1) % 3], a[c], a[(c + 1) % 3]);
-        return;
-    }
-    sphere_refine(s, p, a, 0);
-}
-
 /* ---- the mesh ---- */
 
 /* Height of the top of the layer over a node (cm): its thickness plus the normal displacement of the
@@ -265,7 +103,8 @@ static void top_shift(const fs_wedge_model *w, int32_t node, double *p)
 typedef struct {
     const fs_wedge_model *w;
     fs_render_mesh *out;
-    sphere_ctx sc;
+    fs_sphere_refiner sphere; /* draws the triangles of a sphere (the frame is not flat) */
+    const attr *sphere_attr;  /* the corners' attributes of the triangle it draws */
     double ext[2];   /* the unwrapped rectangle (flat frames) */
     bool wrap[2];    /* flat frames: the axis is periodic (never on the sphere, which has no shifts) */
     double tol;      /* cm: points this close to a line lie on it */
@@ -276,11 +115,20 @@ typedef struct {
     int32_t *parent; /* split: union-find over point ids joining copies where walls cross, or NULL */
 } render_ctx;
 
+/* fs_sphere_refiner.vertex: a vertex with the attributes of the triangle's corners mixed by w. */
+static int32_t sphere_vertex(void *user, double u, double v, const double w[3])
+{
+    const render_ctx *r = user;
+    const attr *a = r->sphere_attr;
+    return add_vertex(r->out, u, v, attr_mix(a[0], a[1], a[2], w[0], w[1], w[2]));
+}
+
 /* One triangle of points in the model frame (flat frames: the unwrapped rectangle, z = 0). */
 static void emit_tri(render_ctx *r, const double p[3][3], const attr a[3])
 {
     if (!r->w->flat) {
-        sphere_triangle(&r->sc, p, a);
+        r->sphere_attr = a;
+        fs_sphere_triangle(&r->sphere, p[0], p[1], p[2]);
         return;
     }
     int32_t v[3];
@@ -508,20 +356,52 @@ static int cmp_on_edge(const void *x, const void *y)
     return a->group < b->group ? -1 : (a->group > b->group);
 }
 
-/* The rest points of the grid strictly inside the rest segment from a to b (a wall edge), sorted
+/* Where rest point x lies along the rest wall edge from a to b: its parameter t, and *off, its
+ * distance from the edge. Flat frames: the foot of x on the segment. Sphere: the edge is the arc of
+ * the great circle through a and b, since the nodes that split an edge are projected onto the
+ * sphere (wedge_split.c); t is where the ray to x meets the chord, *off the distance of x from the
+ * plane of the great circle (or infinite when x is on the far side of the sphere). */
+static double edge_param(const render_ctx *r, const double *a, const double *b, const double *x, double *off)
+{
+    double ab[3], ax[3];
+    fs_sub3(ab, b, a);
+    fs_sub3(ax, x, a);
+    if (r->w->flat) {
+        double t = fs_dot3(ax, ab) / fs_dot3(ab, ab), d[3];
+        for (int q = 0; q < 3; q++)
+            d[q] = ax[q] - t * ab[q];
+        *off = fs_norm3(d);
+        return t;
+    }
+    double m[3], xa[3], xb[3], mid[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
+    fs_cross3(m, a, b);
+    double mm = fs_norm3(m);
+    fs_cross3(xa, a, x);
+    fs_cross3(xb, ab, x);
+    double den = fs_dot3(xb, m);
+    if (!(mm > 0.0) || fs_dot3(x, mid) <= 0.0 || den == 0.0) {
+        *off = INFINITY;
+        return 0.0;
+    }
+    *off = fabs(fs_dot3(x, m)) / mm;
+    return -fs_dot3(xa, m) / den; /* (a + t ab) x x = 0 along m */
+}
+
+/* The rest points of the grid strictly inside the rest wall edge from a to b (edge_param), sorted
  * along it: where a crack ending on this one cut the wall on the other side only. Returns the count
  * (*found grows as needed). */
 static int32_t points_on_edge(const render_ctx *r, const group_grid *g, const double *gpos, const wall_point *a,
                               const wall_point *b, on_edge **found, int32_t *cap)
 {
-    long long lo[2], hi[2];
-    for (int q = 0; q < 2; q++)
-        grid_range(g, q, fmin(a->rest[q], b->rest[q]) - r->tol, fmax(a->rest[q], b->rest[q]) + r->tol, lo + q, hi + q);
     double ab[3], mid[3];
     fs_sub3(ab, b->rest, a->rest);
     for (int k = 0; k < 3; k++)
         mid[k] = 0.5 * (a->rest[k] + b->rest[k]);
-    double len2 = fs_dot3(ab, ab);
+    /* on the sphere the arc bulges out of the chord's box by at most its sagitta, |ab|^2 / (8 R) */
+    double reach = r->tol + (r->w->flat ? 0.0 : fs_dot3(ab, ab) / (4.0 * r->w->mesh->domain.radius));
+    long long lo[2], hi[2];
+    for (int q = 0; q < 2; q++)
+        grid_range(g, q, fmin(a->rest[q], b->rest[q]) - reach, fmax(a->rest[q], b->rest[q]) + reach, lo + q, hi + q);
     int32_t n = 0;
     for (long long iy = lo[1]; iy <= hi[1]; iy++)
         for (long long ix = lo[0]; ix <= hi[0]; ix++) {
@@ -535,14 +415,8 @@ static int32_t points_on_edge(const render_ctx *r, const group_grid *g, const do
                 wall_point x = {.rest = {0}};
                 memcpy(x.rest, gpos + 3 * (size_t)grp, sizeof x.rest);
                 align_point(r, &x, mid);
-                double ax[3], off[3];
-                fs_sub3(ax, x.rest, a->rest);
-                double t = fs_dot3(ax, ab) / len2;
-                if (!(t > 1e-9 && t < 1.0 - 1e-9))
-                    continue;
-                for (int q = 0; q < 3; q++)
-                    off[q] = ax[q] - t * ab[q];
-                if (fs_dot3(off, off) > r->tol * r->tol)
+                double off, t = edge_param(r, a->rest, b->rest, x.rest, &off);
+                if (!(t > 1e-9 && t < 1.0 - 1e-9) || !(off <= r->tol))
                     continue;
                 if (n == *cap) {
                     *cap = *cap ? 2 * *cap : 8;
@@ -1023,8 +897,11 @@ static int32_t close_crossings(render_ctx *r, wall_point *pts, int32_t n_pts, co
  *    the cracks at one rest point leave a small polygon between the copies of the node, filled too;
  *  - crossings of walls where a crack is pressed shut are resolved first (close_crossings).
  * Texture maps do not change except where walls cross: the floor has the attributes of the exposed
- * background. On the sphere the same mesh is drawn, but each triangle is refined on its own
- * (sphere_triangle), so tops and floor do not meet vertex to vertex there and its lift stays open. */
+ * background. On the sphere the same mesh is drawn in 3-D and each triangle is refined into the
+ * texture by fs_sphere_triangle (render/sphere.h), which cuts a shared chord at the same points on
+ * both sides, so tops and floor still meet vertex to vertex and the lift is closed. A wall edge there
+ * is an arc of a great circle, not its chord: the nodes that split an edge lie on the sphere
+ * (points_on_edge, edge_param). */
 static int split_render_mesh(render_ctx *r)
 {
     const fs_wedge_model *w = r->w;
@@ -1194,9 +1071,11 @@ int fs_wedge_render_mesh(const fs_wedge_model *w, fs_render_mesh *out)
 {
     memset(out, 0, sizeof *out);
     const fs_mesh *m = w->mesh;
-    render_ctx r = {w, out, {&m->domain, out}, {fs_domain_extent_x(&m->domain), fs_domain_extent_y(&m->domain)},
-                    {w->flat && fs_domain_wraps_u(&m->domain), w->flat && fs_domain_wraps_v(&m->domain)}, 0.0,
-                    NULL, NULL, NULL, NULL};
+    render_ctx r = {.w = w,
+                    .out = out,
+                    .ext = {fs_domain_extent_x(&m->domain), fs_domain_extent_y(&m->domain)},
+                    .wrap = {w->flat && fs_domain_wraps_u(&m->domain), w->flat && fs_domain_wraps_v(&m->domain)}};
+    r.sphere = (fs_sphere_refiner){&m->domain, SPHERE_UV_TOLERANCE, out, sphere_vertex, &r};
     r.tol = 1e-9 * fmax(r.ext[0], r.ext[1]);
     r.label = fs_malloc(((size_t)w->n_elems + 1) * sizeof *r.label);
     fs_wedge_fragments(w, r.label);
