@@ -27,6 +27,7 @@ hex-springs 256x256 mesh.elements=1500
 curl-springs 256x256 mesh.elements=1500
 mud-remove 256x256 mesh.elements=5000
 bark-remove 171x256 mesh.elements=4000
+mud 256x256 mesh.elements=10000
 mud-gradient 256x171 mesh.elements=4000
 heart 256x256 mesh.elements=6000
 sphere-elongated 256x128 mesh.elements=3000
