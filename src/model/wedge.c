@@ -1506,9 +1506,10 @@ static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_
             size_t len = (size_t)(k->col_ptr[jo + 1] - k->col_ptr[jo2]);
             memmove(k->row_idx + ptr[j2], k->row_idx + k->col_ptr[jo2], len * sizeof *k->row_idx);
             memmove(k->values + ptr[j2], k->values + k->col_ptr[jo2], len * sizeof *k->values);
-            if (j2 >= nf && shift > 0) /* fixed columns: their diagonals move up */
-                for (size_t q = (size_t)ptr[j2]; q < (size_t)ptr[j2] + len; q++)
-                    k->row_idx[q] = (int32_t)new_row(k->row_idx[q], n_free_old, shift);
+            if (j2 >= nf && shift > 0) /* fixed columns: their diagonals (the last entries) move up */
+                for (int32_t c = j2; c <= j; c++)
+                    if (ptr[c + 1] > ptr[c] && k->row_idx[ptr[c + 1] - 1] >= n_free_old)
+                        k->row_idx[ptr[c + 1] - 1] = (int32_t)new_row(k->row_idx[ptr[c + 1] - 1], n_free_old, shift);
             j = j2 - 1;
             continue;
         }
