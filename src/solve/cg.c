@@ -32,6 +32,13 @@ static double max_abs(int32_t n, const double *v)
     return m;
 }
 
+/* The stopping rule: with a max_residual, every entry of r within it, else the Euclidean norm rnorm
+ * within limit. */
+static bool converged(const fs_cg_params *params, int32_t n, const double *r, double rnorm, double limit)
+{
+    return params->max_residual > 0.0 ? max_abs(n, r) <= params->max_residual : rnorm <= limit;
+}
+
 /* r = b - A x, using q as scratch; returns ||r||. */
 static double true_residual(const fs_sparse_matrix *a, const double *b, const double *x, double *r, double *q)
 {
@@ -134,13 +141,10 @@ int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_par
     if (preconditioner(a, block, inv) < 0)
         goto done;
 
-    /* converged: the Euclidean norm rnorm within limit, or with a max_residual, every entry of r */
-    bool by_max = params.max_residual > 0.0;
     double limit = params.tolerance * bnorm;
-#define CONVERGED() (by_max ? max_abs(n, r) <= params.max_residual : rnorm <= limit)
     double rnorm = true_residual(a, b, x, r, q);
     int32_t iterations = 0;
-    if (!CONVERGED()) {
+    if (!converged(&params, n, r, rnorm, limit)) {
         double rz = precondition(n, block, inv, r, z);
         for (int32_t i = 0; i < n; i++)
             p[i] = z[i];
@@ -159,9 +163,9 @@ int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_par
             }
             iterations++;
             rnorm = sqrt(dot(n, r, r));
-            if (CONVERGED()) {
+            if (converged(&params, n, r, rnorm, limit)) {
                 rnorm = true_residual(a, b, x, r, q);
-                if (CONVERGED())
+                if (converged(&params, n, r, rnorm, limit))
                     break;
                 rz = precondition(n, block, inv, r, z);
                 for (int32_t i = 0; i < n; i++)
@@ -177,12 +181,11 @@ int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_par
     }
     if (relative_residual)
         *relative_residual = rnorm / bnorm;
-    if (!CONVERGED()) {
+    if (!converged(&params, n, r, rnorm, limit)) {
         fs_error(FS_ERR_INTERNAL, "cg: no convergence after %d iterations (relative residual %.3g)", iterations,
                  rnorm / bnorm);
         goto done;
     }
-#undef CONVERGED
     status = iterations;
 done:
     free(scratch);
