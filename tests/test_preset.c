@@ -11,7 +11,7 @@
 #include "check.h"
 #include "field/field.h"
 #include "io/preset.h"
-#include "sim/config.h"
+#include "sim/settings.h"
 
 /* Every key set away from its default. */
 static const char *const full_preset =

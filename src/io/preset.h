@@ -4,7 +4,7 @@
 
 #include <stdio.h>
 
-#include "sim/config.h"
+#include "sim/settings.h"
 
 /* Parses the preset file at path over cfg (which the caller set to fs_config_default()). Unknown
  * sections and keys, bad types, values out of range and disallowed words are errors reported as

@@ -5,7 +5,7 @@
 #include <stdint.h>
 
 #include "render/render.h"
-#include "sim/config.h"
+#include "sim/settings.h"
 #include "sim/sim.h"
 
 /* One written map, as the sidecar describes it. */

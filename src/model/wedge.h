@@ -8,7 +8,7 @@
 #include "field/growth.h"
 #include "geom/mesh.h"
 #include "render/render.h"
-#include "sim/config.h"
+#include "sim/settings.h"
 #include "sim/sim.h"
 #include "solve/sparse.h"
 

@@ -6,7 +6,7 @@
 
 #include "geom/mesh.h"
 #include "render/render.h"
-#include "sim/config.h"
+#include "sim/settings.h"
 
 typedef struct {
     int64_t nodes;           /* nodes (or points) of the final mesh */

@@ -1,6 +1,6 @@
 /* The resolved configuration of one run: what a preset (plus overrides) becomes, section by section. */
-#ifndef FS_SIM_CONFIG_H
-#define FS_SIM_CONFIG_H
+#ifndef FS_SIM_SETTINGS_H
+#define FS_SIM_SETTINGS_H
 
 #include <stdbool.h>
 #include <stdint.h>

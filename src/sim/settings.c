@@ -1,5 +1,5 @@
 /* The default configuration of a run, assembled from each section's defaults function. */
-#include "sim/config.h"
+#include "sim/settings.h"
 
 #include <string.h>
 
