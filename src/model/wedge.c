@@ -1671,6 +1671,21 @@ int fs_wedge_refactor(fs_wedge_model *w)
     return factorize(w, false);
 }
 
+/* The rows of f - K u of these nodes changed (wedge_relax.c keeps the rest of the residual between
+ * events); nothing to record while there is no kept residual (global relaxation, or after anything
+ * that invalidated it: the next fs_wedge_relax computes it in full). */
+static void mark_dirty(fs_wedge_model *w, const int32_t *nodes, int32_t nn)
+{
+    if (!w->residual_valid)
+        return;
+    if (w->n_dirty + nn > w->cap_dirty) {
+        w->cap_dirty = 2 * (w->n_dirty + nn);
+        w->dirty_nodes = fs_realloc(w->dirty_nodes, (size_t)w->cap_dirty * sizeof *w->dirty_nodes);
+    }
+    memcpy(w->dirty_nodes + w->n_dirty, nodes, (size_t)nn * sizeof *nodes);
+    w->n_dirty += nn;
+}
+
 int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
 {
     double t0 = fs_seconds();
@@ -1713,12 +1728,7 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
     int rc = extend_system(w, n_free_old, n_fixed_old, changed, n_changed);
     if (rc == 0)
         rc = update_region(w, nodes, nn);
-    if (w->n_dirty + nn > w->cap_dirty) { /* their rows of f - K u changed (wedge_relax.c) */
-        w->cap_dirty = 2 * (w->n_dirty + nn);
-        w->dirty_nodes = fs_realloc(w->dirty_nodes, (size_t)w->cap_dirty * sizeof *w->dirty_nodes);
-    }
-    memcpy(w->dirty_nodes + w->n_dirty, nodes, (size_t)nn * sizeof *nodes);
-    w->n_dirty += nn;
+    mark_dirty(w, nodes, nn);
     if (rc == 0)
         rc = refresh_cache(w, changed, n_changed);
     if (rc == 0) /* the stresses of the changed elements at the displacements carried over */
@@ -1746,12 +1756,7 @@ int fs_wedge_update_geometry(fs_wedge_model *w, const int32_t *elems, int32_t n)
         for (int k = 0; k < 3; k++)
             nodes[nn++] = w->mesh->tri[3 * (size_t)elems[q] + k];
     int rc = update_region(w, nodes, nn);
-    if (w->n_dirty + nn > w->cap_dirty) { /* their rows of f - K u changed (wedge_relax.c) */
-        w->cap_dirty = 2 * (w->n_dirty + nn);
-        w->dirty_nodes = fs_realloc(w->dirty_nodes, (size_t)w->cap_dirty * sizeof *w->dirty_nodes);
-    }
-    memcpy(w->dirty_nodes + w->n_dirty, nodes, (size_t)nn * sizeof *nodes);
-    w->n_dirty += nn;
+    mark_dirty(w, nodes, nn);
     if (rc == 0)
         rc = refresh_cache(w, elems, n);
     if (rc == 0)

@@ -5,6 +5,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "base/vec.h"
 #include "model/wedge.h"
 #include "solve/cg.h"
 #include "solve/sparse.h"
@@ -101,10 +102,11 @@ static double norm_max(const double *v, int32_t n)
 /* Length of the edge from corner a to corner b of element e in the surface mesh at rest (cm). */
 static double edge_length(const fs_mesh *m, int32_t e, int a, int b)
 {
-    double p[3], q[3];
+    double p[3], q[3], d[3];
     fs_mesh_corner(m, e, a, p);
     fs_mesh_corner(m, e, b, q);
-    return sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+    fs_sub3(d, p, q);
+    return fs_norm3(d);
 }
 
 /* Mean edge length of the living elements at rest (cm): the unit of the relaxation radius. */

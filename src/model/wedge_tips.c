@@ -425,13 +425,12 @@ static double angle_2d(const double u[2], const double v[2])
  * the node's tangent frame. */
 typedef struct {
     int32_t n, cap;
-    int32_t *tri, *a, *b;
+    int32_t *a, *b;
     double *ra, *rb; /* 2 each per triangle */
 } fan_t;
 
 static void fan_free(fan_t *f)
 {
-    free(f->tri);
     free(f->a);
     free(f->b);
     free(f->ra);
@@ -459,7 +458,6 @@ static bool fan_of(const fs_wedge_model *w, int32_t i, const frame *f, fan_t *fa
         }
         if (fan->n == fan->cap) {
             fan->cap = fan->cap ? 2 * fan->cap : 16;
-            fan->tri = fs_realloc(fan->tri, (size_t)fan->cap * sizeof *fan->tri);
             fan->a = fs_realloc(fan->a, (size_t)fan->cap * sizeof *fan->a);
             fan->b = fs_realloc(fan->b, (size_t)fan->cap * sizeof *fan->b);
             fan->ra = fs_realloc(fan->ra, 2 * (size_t)fan->cap * sizeof *fan->ra);
@@ -470,7 +468,6 @@ static bool fan_of(const fs_wedge_model *w, int32_t i, const frame *f, fan_t *fa
         fs_mesh_corner(m, t, (c + 1) % 3, pa);
         fs_mesh_corner(m, t, (c + 2) % 3, pb);
         int32_t k = fan->n++;
-        fan->tri[k] = t;
         fan->a[k] = tri[(c + 1) % 3];
         fan->b[k] = tri[(c + 2) % 3];
         fs_sub3(d, pa, pi);
