@@ -419,6 +419,10 @@ int fs_wedge_tip_submodel(fs_wedge_model *w, int32_t node, double radius, double
 int fs_wedge_smooth(fs_wedge_model *w, const int32_t *centres, int32_t n, double radius, int iterations,
                     int32_t *moved);
 
+/* Mean edge length (cm) of the living elements at rest, 1 if there are none: the unit of the
+ * relaxation radius (w->relax_unit) and of the crack-tip radii (fs_wedge_tips_unit). */
+double fs_wedge_mean_edge(const fs_wedge_model *w);
+
 /* The unit of the sub-model and smoothing radii: w->tips_unit, set at the first call to the mean edge
  * length (cm) of the living elements. */
 double fs_wedge_tips_unit(fs_wedge_model *w);

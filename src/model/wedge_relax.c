@@ -109,8 +109,7 @@ static double edge_length(const fs_mesh *m, int32_t e, int a, int b)
     return fs_norm3(d);
 }
 
-/* Mean edge length of the living elements at rest (cm): the unit of the relaxation radius. */
-static double mean_edge(const fs_wedge_model *w)
+double fs_wedge_mean_edge(const fs_wedge_model *w)
 {
     double sum = 0.0;
     int64_t count = 0;
@@ -529,7 +528,7 @@ int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n)
 {
     double t0 = fs_seconds();
     if (w->relax_unit <= 0.0) {
-        w->relax_unit = mean_edge(w);
+        w->relax_unit = fs_wedge_mean_edge(w);
         w->relax_radius = w->cfg.solver.relax_radius * w->relax_unit;
     }
     int32_t nf = w->n_free, nn = w->n_nodes;

@@ -929,8 +929,8 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed)
     if (pick < 0)
         return 1;
 
-    int32_t bisected = 0;
-    if (subdivide_around(w, pick, &bisected) < 0)
+    int32_t bisected = 0; /* (a tip the sub-model accepted was subdivided around already) */
+    if (!have_m && subdivide_around(w, pick, &bisected) < 0)
         return -1;
     if (bisected > 0) {
         /* new midpoint nodes carry no displacement yet: a global solve, not a local relaxation */

@@ -32,24 +32,8 @@ static int corner_of(const fs_mesh *m, int32_t t, int32_t node)
 
 double fs_wedge_tips_unit(fs_wedge_model *w)
 {
-    if (w->tips_unit > 0.0)
-        return w->tips_unit;
-    double sum = 0.0;
-    int64_t count = 0;
-    for (int32_t e = 0; e < w->n_elems; e++) {
-        if (w->state[e] != FS_WEDGE_ALIVE)
-            continue;
-        double p[3][3];
-        for (int c = 0; c < 3; c++)
-            fs_mesh_corner(w->mesh, e, c, p[c]);
-        for (int c = 0; c < 3; c++) {
-            double d[3];
-            fs_sub3(d, p[(c + 1) % 3], p[c]);
-            sum += fs_norm3(d);
-        }
-        count += 3;
-    }
-    w->tips_unit = count ? sum / (double)count : 1.0;
+    if (w->tips_unit <= 0.0)
+        w->tips_unit = fs_wedge_mean_edge(w);
     return w->tips_unit;
 }
 
