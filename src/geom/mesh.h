@@ -2,6 +2,7 @@
 #ifndef FS_GEOM_MESH_H
 #define FS_GEOM_MESH_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "geom/domain.h"
@@ -69,6 +70,15 @@ void fs_mesh_build_rings(fs_mesh *m);
 
 /* Unwrapped position of corner c (0..2) of triangle t (see the design note). out has 3 components. */
 void fs_mesh_corner(const fs_mesh *m, int32_t t, int c, double *out);
+
+/* The corner (0..2) of triangle t at node, or -1 if node is none of its corners. */
+static inline int fs_mesh_corner_of(const fs_mesh *m, int32_t t, int32_t node)
+{
+    for (int c = 0; c < 3; c++)
+        if (m->tri[3 * (size_t)t + c] == node)
+            return c;
+    return -1;
+}
 
 /* Outward unit normal (x, y; z = 0) of the boundary edge from corner i to corner (i+1)%3 of triangle t
  * (plane and cylinder; the triangle lies to the edge's left), in the unwrapped frame of t. */

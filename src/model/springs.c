@@ -72,14 +72,6 @@ static double map_sample(const grey_map *m, const double *uv, bool wrap_u, bool 
 
 static void map_free(grey_map *m) { free(m->grey); }
 
-static int corner_of(const fs_mesh *m, int32_t t, int32_t node)
-{
-    for (int c = 0; c < 3; c++)
-        if (m->tri[3 * (size_t)t + c] == node)
-            return c;
-    return -1;
-}
-
 /* Texture coordinates of a domain point given unwrapped (wrapped here first). */
 static void point_uv(const fs_domain *d, const double *p, double *uv)
 {
@@ -399,7 +391,7 @@ int fs_springs_init(fs_springs *s, const fs_mesh *m, const fs_springs_setup *set
         double off[2] = {0.0, 0.0}, d[3], mid[3];
         if (!sphere) {
             int32_t t = m->edge_tri[2 * e];
-            int ca = corner_of(m, t, a), cb = corner_of(m, t, b);
+            int ca = fs_mesh_corner_of(m, t, a), cb = fs_mesh_corner_of(m, t, b);
             FS_ASSERT(ca >= 0 && cb >= 0);
             const int8_t *sh = m->shift + 6 * (size_t)t;
             for (int q = 0; q < 2; q++)

@@ -10,6 +10,7 @@
 #include "fracture/split.h"
 #include "geom/refine.h"
 #include "model/wedge.h"
+#include "model/wedge_frame.h"
 
 /* design: thesis §5.7. The layer is a surface mesh extruded into wedge columns, and a crack always
  * cuts a whole column (the top and the bottom node of a mesh node together), so splitting is a 2-D
@@ -72,56 +73,7 @@
 /* Edge rings around the breaking node whose elements the Griffith energies are summed over. */
 #define GRIFFITH_RINGS 6
 
-/* ---- frames ---- */
-
-typedef struct {
-    bool flat;
-    double e1[3], e2[3];
-} frame;
-
-static void frame_at(const fs_wedge_model *w, int32_t n, frame *f)
-{
-    f->flat = w->flat;
-    if (f->flat) {
-        f->e1[0] = 1.0, f->e1[1] = 0.0, f->e1[2] = 0.0;
-        f->e2[0] = 0.0, f->e2[1] = 1.0, f->e2[2] = 0.0;
-        return;
-    }
-    const double *nrm = w->normal + 3 * (size_t)n;
-    double axis[3] = {0.0, 0.0, 1.0};
-    if (fabs(nrm[2]) > 0.9) {
-        axis[0] = 1.0;
-        axis[2] = 0.0;
-    }
-    fs_cross3(f->e1, axis, nrm);
-    double len = fs_norm3(f->e1);
-    for (int k = 0; k < 3; k++)
-        f->e1[k] /= len;
-    fs_cross3(f->e2, nrm, f->e1);
-}
-
-static void to_2d(const frame *f, const double v[3], double out[2])
-{
-    out[0] = fs_dot3(f->e1, v);
-    out[1] = fs_dot3(f->e2, v);
-}
-
-static void from_2d(const frame *f, const double v[2], double out[3])
-{
-    for (int k = 0; k < 3; k++)
-        out[k] = v[0] * f->e1[k] + v[1] * f->e2[k];
-}
-
 /* ---- the nodal criterion ---- */
-
-/* The corner of triangle t at node, or -1. */
-static int corner_of(const fs_mesh *m, int32_t t, int32_t node)
-{
-    for (int c = 0; c < 3; c++)
-        if (m->tri[3 * (size_t)t + c] == node)
-            return c;
-    return -1;
-}
 
 /* The top stresses the criterion reads: a, or the blend a + s (b - a) when b is not NULL. */
 typedef struct {
@@ -165,7 +117,7 @@ static double tip_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t 
         int32_t e = w->node_elem[p];
         if (w->state[e] != FS_WEDGE_ALIVE)
             continue;
-        int c = corner_of(w->mesh, e, i);
+        int c = fs_mesh_corner_of(w->mesh, e, i);
         double d[3];
         double r = point_ratio(w, st, e, c, d);
         if (r > best) {
@@ -188,7 +140,7 @@ static double node_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t
         int32_t e = w->node_elem[p];
         if (w->state[e] != FS_WEDGE_ALIVE)
             continue;
-        int c = corner_of(w->mesh, e, i);
+        int c = fs_mesh_corner_of(w->mesh, e, i);
         double v[6];
         stress_at(st, e, c, v);
         for (int k = 0; k < 6; k++)
@@ -444,18 +396,18 @@ static void tris_at(const fs_wedge_model *w, int32_t i, ilist *out)
     out->n = 0;
     const fs_mesh *m = w->mesh;
     for (int32_t t = 0; t < m->n_tris; t++)
-        if ((t >= w->n_elems || w->state[t] == FS_WEDGE_ALIVE) && corner_of(m, t, i) >= 0)
+        if ((t >= w->n_elems || w->state[t] == FS_WEDGE_ALIVE) && fs_mesh_corner_of(m, t, i) >= 0)
             ilist_push(out, t);
 }
 
 /* Corner c of triangle t relative to corner cn, in the 2-D frame. */
-static void rel_2d(const fs_mesh *m, const frame *f, int32_t t, int cn, int c, double out[2])
+static void rel_2d(const fs_mesh *m, const fs_wedge_frame *f, int32_t t, int cn, int c, double out[2])
 {
     double a[3], b[3], d[3];
     fs_mesh_corner(m, t, cn, a);
     fs_mesh_corner(m, t, c, b);
     fs_sub3(d, b, a);
-    to_2d(f, d, out);
+    fs_wedge_frame_to_2d(f, d, out);
 }
 
 /* Splits edge ab (corners ia, ib = ia + 1 of triangle t) at a + s (b - a), and the neighbour across
@@ -483,7 +435,7 @@ static int32_t split_edge(cut_state *cs, int32_t t, int ia, double s)
     normalize_shifts(m, t2);
     mark_changed(cs, t);
     if (u >= 0) {
-        int ua = corner_of(m, u, a), ub = corner_of(m, u, b);
+        int ua = fs_mesh_corner_of(m, u, a), ub = fs_mesh_corner_of(m, u, b);
         double qa[3], qb[3], pu[3];
         fs_mesh_corner(m, u, ua, qa);
         fs_mesh_corner(m, u, ub, qb);
@@ -501,7 +453,7 @@ static int32_t split_edge(cut_state *cs, int32_t t, int ia, double s)
 }
 
 /* Twice the signed area of triangle t projected into frame f. */
-static double area_2d(const fs_mesh *m, const frame *f, int32_t t)
+static double area_2d(const fs_mesh *m, const fs_wedge_frame *f, int32_t t)
 {
     double a[2], b[2];
     rel_2d(m, f, t, 0, 1, a);
@@ -512,14 +464,14 @@ static double area_2d(const fs_mesh *m, const frame *f, int32_t t)
 /* Edge collapse (Algorithm 12): moves free node v by delta (2-D, frame f) if every triangle around
  * it keeps COLLAPSE_MIN_AREA of its area and the node stays inside the fundamental domain.
  * Returns true if it moved. */
-static bool collapse(cut_state *cs, const frame *f, int32_t v, const double delta[2], const uint8_t *open)
+static bool collapse(cut_state *cs, const fs_wedge_frame *f, int32_t v, const double delta[2], const uint8_t *open)
 {
     fs_wedge_model *w = cs->w;
     fs_mesh *m = w->mesh;
     if (v < w->n_nodes && (open[v] || w->pinned[v] || tip_find(w, v) >= 0))
         return false;
     double d3[3], old[3], moved[3], wrapped[3];
-    from_2d(f, delta, d3);
+    fs_wedge_frame_from_2d(f, delta, d3);
     memcpy(old, m->pos + 3 * (size_t)v, sizeof old);
     for (int k = 0; k < 3; k++)
         moved[k] = old[k] + d3[k];
@@ -548,7 +500,7 @@ static bool collapse(cut_state *cs, const frame *f, int32_t v, const double delt
 
 /* One ray from n along d (2-D, frame f): splits or snaps, returns the far end of the cut (-1 when the
  * ray leaves through a gap of the fan: nothing cut). */
-static int32_t cast_ray(cut_state *cs, const frame *f, int32_t n, const double d[2], const uint8_t *open)
+static int32_t cast_ray(cut_state *cs, const fs_wedge_frame *f, int32_t n, const double d[2], const uint8_t *open)
 {
     fs_wedge_model *w = cs->w;
     fs_mesh *m = w->mesh;
@@ -557,7 +509,7 @@ static int32_t cast_ray(cut_state *cs, const frame *f, int32_t n, const double d
     int32_t far = -1;
     for (int32_t q = 0; q < fan.n && far < 0; q++) {
         int32_t t = fan.v[q];
-        int cn = corner_of(m, t, n), ia = (cn + 1) % 3, ib = (cn + 2) % 3;
+        int cn = fs_mesh_corner_of(m, t, n), ia = (cn + 1) % 3, ib = (cn + 2) % 3;
         double a[2], b[2], s;
         rel_2d(m, f, t, cn, ia, a);
         rel_2d(m, f, t, cn, ib, b);
@@ -603,7 +555,7 @@ static int32_t duplicate_node(cut_state *cs, int32_t v, const int32_t *cut, int3
         parent[q] = q;
     for (int32_t q = 0; q < fan.n; q++) {
         int32_t t = fan.v[q];
-        int c = corner_of(m, t, v);
+        int c = fs_mesh_corner_of(m, t, v);
         for (int side = 0; side < 2; side++) {
             int edge = side ? c : (c + 2) % 3; /* the two edges of t at v */
             int32_t other = m->tri[3 * (size_t)t + (side ? (c + 1) % 3 : (c + 2) % 3)];
@@ -636,7 +588,7 @@ static int32_t duplicate_node(cut_state *cs, int32_t v, const int32_t *cut, int3
     for (int32_t q = 0; q < fan.n; q++)
         if (copy[q] != v) {
             int32_t t = fan.v[q];
-            m->tri[3 * (size_t)t + corner_of(m, t, v)] = copy[q];
+            m->tri[3 * (size_t)t + fs_mesh_corner_of(m, t, v)] = copy[q];
             mark_changed(cs, t);
         }
     free(copy);
@@ -719,14 +671,14 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
                        double lengths[2])
 {
     fs_mesh *m = w->mesh;
-    frame f;
-    frame_at(w, n, &f);
+    fs_wedge_frame f;
+    fs_wedge_frame_at(w, n, &f);
     uint8_t *open = open_nodes(w);
     cut_state cs = {w, m->n_nodes, m->n_tris, {0}, NULL, {0}, fs_calloc((size_t)m->n_tris + 1, 1), {0}, m->n_tris};
     int cuts = 0;
     for (int r = 0; r < n_rays; r++) {
         double d[2];
-        to_2d(&f, rays[r], d);
+        fs_wedge_frame_to_2d(&f, rays[r], d);
         double len = hypot(d[0], d[1]);
         ends[r] = -1;
         lengths[r] = 0.0;
@@ -818,13 +770,13 @@ static int smooth_new_tips(fs_wedge_model *w, const int32_t ends[2], int n_rays)
 /* The in-plane crack direction at node n from the fracture plane normal m (3-D). */
 static bool crack_direction(const fs_wedge_model *w, int32_t n, const double m[3], double dir[3])
 {
-    frame f;
-    frame_at(w, n, &f);
+    fs_wedge_frame f;
+    fs_wedge_frame_at(w, n, &f);
     double m2[2], d2[2];
-    to_2d(&f, m, m2);
+    fs_wedge_frame_to_2d(&f, m, m2);
     if (!fs_split_crack_direction(m2, d2))
         return false;
-    from_2d(&f, d2, dir);
+    fs_wedge_frame_from_2d(&f, d2, dir);
     return true;
 }
 

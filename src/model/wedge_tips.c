@@ -9,6 +9,7 @@
 #include "fracture/eigen.h"
 #include "geom/refine.h"
 #include "model/wedge.h"
+#include "model/wedge_frame.h"
 
 /* Refinement passes of a sub-model around its tip (each bisects the tip's vicinity once, with
  * propagation); a bound, reached only with a tip_submodel_size far below the mesh. */
@@ -20,14 +21,6 @@ static int cmp_int32(const void *a, const void *b)
 {
     int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
     return (x > y) - (x < y);
-}
-
-static int corner_of(const fs_mesh *m, int32_t t, int32_t node)
-{
-    for (int c = 0; c < 3; c++)
-        if (m->tri[3 * (size_t)t + c] == node)
-            return c;
-    return -1;
 }
 
 double fs_wedge_tips_unit(fs_wedge_model *w)
@@ -167,7 +160,7 @@ static int32_t tip_vicinity(const fs_mesh *m, int32_t tip, double size, uint8_t 
 {
     int32_t n = 0;
     for (int32_t t = 0; t < m->n_tris; t++) {
-        if (corner_of(m, t, tip) < 0)
+        if (fs_mesh_corner_of(m, t, tip) < 0)
             continue;
         for (int k = -1; k < 3; k++) {
             int32_t u = k < 0 ? t : m->adj[3 * (size_t)t + k];
@@ -325,7 +318,7 @@ int fs_wedge_tip_submodel(fs_wedge_model *w, int32_t node, double radius, double
         free(list);
     }
     for (int32_t t = 0; t < sm.n_tris; t++)
-        if (corner_of(&sm, t, tip) >= 0)
+        if (fs_mesh_corner_of(&sm, t, tip) >= 0)
             inf.tip_size = fmax(inf.tip_size, fs_refine_tri_size(&sm, t));
 
     /* 4. the sub-model, assembled and factorized once its data are in */
@@ -373,32 +366,6 @@ done:
 
 /* ---- §5.7.9: angle-based smoothing near crack tips ---- */
 
-/* The tangent plane at a node: the flat frame's x and y, or on the sphere a right-handed pair
- * (e1, e2, normal), so triangles counter-clockwise from outside are counter-clockwise in it. */
-typedef struct {
-    double e1[3], e2[3];
-} frame;
-
-static void frame_at(const fs_wedge_model *w, int32_t n, frame *f)
-{
-    if (w->flat) {
-        f->e1[0] = 1.0, f->e1[1] = 0.0, f->e1[2] = 0.0;
-        f->e2[0] = 0.0, f->e2[1] = 1.0, f->e2[2] = 0.0;
-        return;
-    }
-    const double *nrm = w->normal + 3 * (size_t)n;
-    double axis[3] = {0.0, 0.0, 1.0};
-    if (fabs(nrm[2]) > 0.9) {
-        axis[0] = 1.0;
-        axis[2] = 0.0;
-    }
-    fs_cross3(f->e1, axis, nrm);
-    double len = fs_norm3(f->e1);
-    for (int k = 0; k < 3; k++)
-        f->e1[k] /= len;
-    fs_cross3(f->e2, nrm, f->e1);
-}
-
 /* Interior angle between 2-D vectors u and v, in [0, pi]. */
 static double angle_2d(const double u[2], const double v[2])
 {
@@ -423,7 +390,7 @@ static void fan_free(fan_t *f)
 
 /* Fills the fan of node i; false if i is not fully surrounded by living elements (an element around it
  * removed, an edge at it on a crack wall or the border) or appears twice in a triangle. */
-static bool fan_of(const fs_wedge_model *w, int32_t i, const frame *f, fan_t *fan)
+static bool fan_of(const fs_wedge_model *w, int32_t i, const fs_wedge_frame *f, fan_t *fan)
 {
     const fs_mesh *m = w->mesh;
     fan->n = 0;
@@ -431,7 +398,7 @@ static bool fan_of(const fs_wedge_model *w, int32_t i, const frame *f, fan_t *fa
         int32_t t = w->node_elem[p];
         if (w->state[t] != FS_WEDGE_ALIVE)
             return false;
-        int c = corner_of(m, t, i);
+        int c = fs_mesh_corner_of(m, t, i);
         const int32_t *tri = m->tri + 3 * (size_t)t;
         if (tri[(c + 1) % 3] == i || tri[(c + 2) % 3] == i)
             return false;
@@ -504,8 +471,8 @@ static double fan_min_angle(const fan_t *fan, const double d[2], bool *positive)
 static bool smooth_node(fs_wedge_model *w, int32_t i, fan_t *fan)
 {
     fs_mesh *m = w->mesh;
-    frame f;
-    frame_at(w, i, &f);
+    fs_wedge_frame f;
+    fs_wedge_frame_at(w, i, &f);
     if (!fan_of(w, i, &f, fan))
         return false;
     /* per neighbour: its relative position and the two angles at it beside the edge to i */
@@ -553,13 +520,13 @@ static bool smooth_node(fs_wedge_model *w, int32_t i, fan_t *fan)
         memcpy(m->pos + 3 * (size_t)i, wrapped, sizeof wrapped);
         if (!w->flat) { /* the projection onto the sphere moved it off the plane: check again */
             fs_domain_normal(&m->domain, wrapped, w->normal + 3 * (size_t)i);
-            frame g;
-            frame_at(w, i, &g);
+            fs_wedge_frame g;
+            fs_wedge_frame_at(w, i, &g);
             double after = fan_of(w, i, &g, fan) ? fan_min_angle(fan, zero, &positive) : -INFINITY;
             if (!(after >= before) || !positive) {
                 memcpy(m->pos + 3 * (size_t)i, old, sizeof old);
                 fs_domain_normal(&m->domain, old, w->normal + 3 * (size_t)i);
-                frame_at(w, i, &f);
+                fs_wedge_frame_at(w, i, &f);
                 fan_of(w, i, &f, fan);
                 continue;
             }
