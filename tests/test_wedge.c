@@ -7,6 +7,7 @@
 #include "base/error.h"
 #include "base/vec.h"
 #include "check.h"
+#include "wedge_fixture.h"
 #include "fracture/eigen.h"
 #include "fracture/event.h"
 #include "geom/delaunay.h"
@@ -34,22 +35,6 @@ static fs_config base_config(void)
     c.solver.tolerance = 1e-10;
     c.solver.relax = FS_RELAX_GLOBAL; /* the factor updates after removals (test_wedge_relax covers local) */
     return c;
-}
-
-/* Meshes cfg's domain as fs_sim_run does, with `points` points. */
-static int make_mesh(const fs_config *cfg, int32_t points, fs_mesh *m)
-{
-    fs_domain d = cfg->domain;
-    fs_domain_normalize(&d);
-    fs_sample_params sp = fs_sample_params_default();
-    sp.count = points;
-    sp.seed = cfg->preset.seed;
-    fs_points pts = {0};
-    if (fs_sample_repulsion(&d, &sp, &pts) < 0)
-        return -1;
-    int rc = fs_delaunay(&d, &pts, m);
-    fs_points_free(&pts);
-    return rc;
 }
 
 /* A linear ramp from 0 at t = 0 to v at t = 1. */
@@ -92,7 +77,7 @@ static void test_bonded_layer_shrinkage(void)
     cfg.shrink.top = ramp(eps);
     cfg.shrink.bottom = ramp(eps);
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 1200, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 1200, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     CHECK(fs_wedge_equilibrium(&w, 1.0) == 0);
@@ -159,7 +144,7 @@ static void test_anisotropic_growth(void)
     for (int periodic = 0; periodic < 2; periodic++) {
         cfg.domain.periodic_x = cfg.domain.periodic_y = periodic;
         fs_mesh m = {0};
-        CHECK(make_mesh(&cfg, 1200, &m) == 0);
+        CHECK(wedge_test_mesh(&cfg, 1200, &m) == 0);
         fs_wedge_model w;
         CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
         CHECK(w.growth_mode == (periodic ? FS_WEDGE_GROWTH_EIGENSTRAIN : FS_WEDGE_GROWTH_MOVE));
@@ -202,7 +187,7 @@ static void test_patch(void)
     cfg.domain.height = 3.0;
     cfg.material.thickness = 0.3;
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 160, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 160, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     const double A[2][2] = {{1e-3, 2e-4}, {-5e-4, 3e-4}}, a = 4e-4, b = -2e-4, nu = cfg.material.poisson;
@@ -271,7 +256,7 @@ static void test_event_time(void)
     cfg.shrink.top = ramp(2e-3);
     cfg.shrink.bottom = ramp(5e-4);
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 100, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 100, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     fs_event_result r;
@@ -307,8 +292,8 @@ static void test_cholmod_vs_cg(void)
     cfg.shrink.top = ramp(3e-3);
     cfg.shrink.bottom = ramp(1e-3);
     fs_mesh m1 = {0}, m2 = {0};
-    CHECK(make_mesh(&cfg, 600, &m1) == 0);
-    CHECK(make_mesh(&cfg, 600, &m2) == 0);
+    CHECK(wedge_test_mesh(&cfg, 600, &m1) == 0);
+    CHECK(wedge_test_mesh(&cfg, 600, &m2) == 0);
     fs_wedge_model a, b;
     cfg.solver.method = FS_SOLVER_CHOLMOD;
     CHECK(fs_wedge_init(&a, &m1, &cfg) == 0);
@@ -343,7 +328,7 @@ static void test_updates_match_fresh_assembly(void)
     cfg.shrink.bottom = ramp(1e-3);
     cfg.mesh.min_size = 0.05;
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 400, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 400, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     /* all the elements around node 10 (orphaning its top node), and a scattered few */
@@ -388,7 +373,7 @@ static void test_cylinder_growth(void)
     cfg.growth.type = FS_GROWTH_CYLINDER;
     cfg.growth.rate = 0.5;
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 600, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 600, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     double t = 2e-3, eps = cfg.growth.rate * t / cfg.domain.radius, nu = cfg.material.poisson;
@@ -422,7 +407,7 @@ static void test_sphere_growth(void)
     cfg.growth.rate = 1.0;
     cfg.growth.axis_ratio = 1.0;
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 1500, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 1500, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     CHECK(w.growth_mode == FS_WEDGE_GROWTH_MOVE && !w.flat);
@@ -456,7 +441,7 @@ static void test_removal_run(void)
     cfg.shrink.bottom = ramp(2e-3);
     cfg.time.min_step = 1e-3;
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 400, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 400, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     CHECK(fs_wedge_simulate(&w, 1.0) == 0);
@@ -504,7 +489,7 @@ static void test_subdivision_run(void)
     cfg.shrink.bottom = ramp(1.5e-3);
     cfg.mesh.min_size = 0.2;
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 60, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 60, &m) == 0);
     int32_t tris0 = m.n_tris;
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
@@ -560,8 +545,8 @@ static void test_lazy_ratios(void)
     cfg.shrink.top = ramp(2e-3);
     cfg.shrink.bottom = ramp(2e-3);
     fs_mesh m1 = {0}, m2 = {0};
-    CHECK(make_mesh(&cfg, 400, &m1) == 0);
-    CHECK(make_mesh(&cfg, 400, &m2) == 0);
+    CHECK(wedge_test_mesh(&cfg, 400, &m1) == 0);
+    CHECK(wedge_test_mesh(&cfg, 400, &m2) == 0);
     fs_wedge_model a, b;
     CHECK(fs_wedge_init(&a, &m1, &cfg) == 0);
     CHECK(fs_wedge_init(&b, &m2, &cfg) == 0);
@@ -611,8 +596,8 @@ static void test_thickness_over_time(void)
     cfg.material.thickness = 0.2;
     cfg.material.thickness_final = 0.6;
     fs_mesh m1 = {0}, m2 = {0};
-    CHECK(make_mesh(&cfg, 150, &m1) == 0);
-    CHECK(make_mesh(&cfg, 150, &m2) == 0);
+    CHECK(wedge_test_mesh(&cfg, 150, &m1) == 0);
+    CHECK(wedge_test_mesh(&cfg, 150, &m2) == 0);
     fs_wedge_model a, b;
     CHECK(fs_wedge_init(&a, &m1, &cfg) == 0);
     CHECK(fs_wedge_remove(&a, 7) == 0);
@@ -650,7 +635,7 @@ static void test_thickness_gradient_and_map(void)
     cfg.wedge.thickness_gradient = 0.8;
     snprintf(cfg.material.thickness_map, sizeof cfg.material.thickness_map, "%s", path);
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 200, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 200, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     CHECK(fs_wedge_equilibrium(&w, 0.0) == 0);

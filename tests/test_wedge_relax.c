@@ -6,6 +6,7 @@
 
 #include "base/error.h"
 #include "check.h"
+#include "wedge_fixture.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
 #include "model/wedge.h"
@@ -32,21 +33,6 @@ static fs_config base_config(double size, fs_relax_mode relax)
     c.shrink.top.v[1] = 2e-3;
     c.shrink.bottom.v[1] = 1e-3;
     return c;
-}
-
-static int make_mesh(const fs_config *cfg, int32_t points, fs_mesh *m)
-{
-    fs_domain d = cfg->domain;
-    fs_domain_normalize(&d);
-    fs_sample_params sp = fs_sample_params_default();
-    sp.count = points;
-    sp.seed = cfg->preset.seed;
-    fs_points pts = {0};
-    if (fs_sample_repulsion(&d, &sp, &pts) < 0)
-        return -1;
-    int rc = fs_delaunay(&d, &pts, m);
-    fs_points_free(&pts);
-    return rc;
 }
 
 /* The element whose centroid is nearest (x, y). */
@@ -120,7 +106,7 @@ static void test_local_matches_global(void)
 {
     fs_config cfg = base_config(6.0, FS_RELAX_LOCAL);
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 1500, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 1500, &m) == 0);
     fs_wedge_model a, b;
     pair_init(&m, 6.0, &a, &b);
     const double spots[3][2] = {{3.0, 3.0}, {3.1, 3.05}, {1.5, 4.0}};
@@ -178,7 +164,7 @@ static void test_crack_is_barrier(void)
 {
     fs_config cfg = base_config(4.0, FS_RELAX_LOCAL);
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 800, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 800, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     CHECK(fs_wedge_equilibrium(&w, 1.0) == 0);
@@ -250,7 +236,7 @@ static void test_radius_control(void)
 {
     fs_config cfg = base_config(4.0, FS_RELAX_LOCAL);
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 800, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 800, &m) == 0);
     fs_wedge_model w, g;
     pair_init(&m, 4.0, &w, &g);
     CHECK(fs_wedge_relax(&w, NULL, 0) == 0); /* in balance: nothing to do, the radius is set */
@@ -304,7 +290,7 @@ static void test_far_change_is_local(void)
     cfg.material.thickness = 0.1;
     cfg.solver.relax_tolerance = fs_config_default().solver.relax_tolerance;
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 5000, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 5000, &m) == 0);
     fs_wedge_model a, b;
     pair_init_with(&m, cfg, &a, &b);
     int32_t e = element_near(&m, 5.0, 5.0);

@@ -7,56 +7,11 @@
 #include "base/error.h"
 #include "base/vec.h"
 #include "check.h"
+#include "wedge_fixture.h"
 #include "geom/delaunay.h"
 #include "geom/refine.h"
 #include "geom/sample.h"
 #include "model/wedge.h"
-
-/* A periodic 4 x 4 cm layer (E = 10 MPa, nu = 0.3, threshold 100 kPa, 0.2 cm thick) stretched along
- * x by planar growth (r1 along x, nothing along y): uniaxial tension sigma_xx. */
-static fs_config strip_config(void)
-{
-    fs_config c = fs_config_default();
-    c.preset.model = FS_MODEL_WEDGE;
-    c.preset.seed = 3;
-    c.domain.type = FS_DOMAIN_PLANE;
-    c.domain.width = 4.0;
-    c.domain.height = 4.0;
-    c.domain.periodic_x = c.domain.periodic_y = true;
-    c.material.young = 10.0;
-    c.material.poisson = 0.3;
-    c.material.threshold = 100.0;
-    c.material.jitter = 0.1;
-    c.material.thickness = 0.2;
-    c.material.thickness_final = -1.0;
-    c.material.toughness = 0.0;
-    c.growth.type = FS_GROWTH_PLANAR;
-    c.growth.r1 = 0.05;
-    c.growth.r2 = 0.0;
-    c.growth.angle = 0.0;
-    c.fracture.method = FS_FRACTURE_SPLIT;
-    c.fracture.griffith = false;
-    c.time.end = 1.0;
-    c.time.min_step = 1e-3;
-    c.mesh.min_size = 1e3;
-    c.solver.relax = FS_RELAX_LOCAL;
-    return c;
-}
-
-static int make_mesh(const fs_config *cfg, int32_t points, fs_mesh *m)
-{
-    fs_domain d = cfg->domain;
-    fs_domain_normalize(&d);
-    fs_sample_params sp = fs_sample_params_default();
-    sp.count = points;
-    sp.seed = cfg->preset.seed;
-    fs_points pts = {0};
-    if (fs_sample_repulsion(&d, &sp, &pts) < 0)
-        return -1;
-    int rc = fs_delaunay(&d, &pts, m);
-    fs_points_free(&pts);
-    return rc;
-}
 
 /* Crack edges of a periodic mesh: boundary half-edges (each crack edge appears once per side). Sums
  * their length and the length-weighted doubled-angle moments of their directions. */
@@ -192,9 +147,9 @@ static void check_valid(const fs_wedge_model *w)
 /* The first crack under uniaxial tension along x runs along y, and splitting keeps the mesh valid. */
 static void test_crack_perpendicular(void)
 {
-    fs_config cfg = strip_config();
+    fs_config cfg = wedge_strip_config();
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 450, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     int32_t nodes0 = w.n_nodes;
@@ -220,9 +175,9 @@ static void test_crack_perpendicular(void)
 /* One split at an interior node: node count and wall area grow as expected. */
 static void test_single_split(void)
 {
-    fs_config cfg = strip_config();
+    fs_config cfg = wedge_strip_config();
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 400, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 400, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     double t = 0.0;
@@ -274,10 +229,10 @@ static double csc_entry(const fs_sparse_matrix *k, int32_t row, int32_t col)
  * growth that moves the fixed bottom nodes, so the fixed columns are exercised too. */
 static void test_extended_matrix_is_fresh(void)
 {
-    fs_config cfg = strip_config();
+    fs_config cfg = wedge_strip_config();
     cfg.domain.periodic_x = cfg.domain.periodic_y = false;
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 600, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 600, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     CHECK(fs_wedge_simulate(&w, 1.0) == 0);
@@ -330,11 +285,11 @@ static void test_griffith(void)
     double length[2];
     int64_t stops[2];
     for (int k = 0; k < 2; k++) {
-        fs_config cfg = strip_config();
+        fs_config cfg = wedge_strip_config();
         cfg.fracture.griffith = true;
         cfg.material.toughness = k ? 1e6 : 0.0;
         fs_mesh m = {0};
-        CHECK(make_mesh(&cfg, 450, &m) == 0);
+        CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
         fs_wedge_model w;
         CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
         CHECK(fs_wedge_simulate(&w, 0.3) == 0);

@@ -8,57 +8,18 @@
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "check.h"
+#include "wedge_fixture.h"
 #include "geom/delaunay.h"
 #include "geom/refine.h"
 #include "geom/sample.h"
 #include "model/wedge.h"
 
-/* A periodic 4 x 4 cm layer (E = 10 MPa, nu = 0.3, threshold 100 kPa, 0.2 cm thick) stretched along
- * x by planar growth (r1 along x, nothing along y): uniaxial tension sigma_xx (as in
- * test_wedge_split.c). */
+/* The strip of wedge_fixture.h, relaxed to a tight tolerance. */
 static fs_config strip_config(void)
 {
-    fs_config c = fs_config_default();
-    c.preset.model = FS_MODEL_WEDGE;
-    c.preset.seed = 3;
-    c.domain.type = FS_DOMAIN_PLANE;
-    c.domain.width = 4.0;
-    c.domain.height = 4.0;
-    c.domain.periodic_x = c.domain.periodic_y = true;
-    c.material.young = 10.0;
-    c.material.poisson = 0.3;
-    c.material.threshold = 100.0;
-    c.material.jitter = 0.1;
-    c.material.thickness = 0.2;
-    c.material.thickness_final = -1.0;
-    c.material.toughness = 0.0;
-    c.growth.type = FS_GROWTH_PLANAR;
-    c.growth.r1 = 0.05;
-    c.growth.r2 = 0.0;
-    c.growth.angle = 0.0;
-    c.fracture.method = FS_FRACTURE_SPLIT;
-    c.fracture.griffith = false;
-    c.time.end = 1.0;
-    c.time.min_step = 1e-3;
-    c.mesh.min_size = 1e3;
-    c.solver.relax = FS_RELAX_LOCAL;
+    fs_config c = wedge_strip_config();
     c.solver.relax_tolerance = 1e-6;
     return c;
-}
-
-static int make_mesh(const fs_config *cfg, int32_t points, fs_mesh *m)
-{
-    fs_domain d = cfg->domain;
-    fs_domain_normalize(&d);
-    fs_sample_params sp = fs_sample_params_default();
-    sp.count = points;
-    sp.seed = cfg->preset.seed;
-    fs_points pts = {0};
-    if (fs_sample_repulsion(&d, &sp, &pts) < 0)
-        return -1;
-    int rc = fs_delaunay(&d, &pts, m);
-    fs_points_free(&pts);
-    return rc;
 }
 
 /* Brings the layer just over its threshold, then runs events (relaxing after each) until one crack
@@ -265,7 +226,7 @@ static void test_vm_refinement(void)
     const double threshold = 0.25;
     fs_config cfg = strip_config();
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 450, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     grow_crack(&w, 3);
@@ -344,7 +305,7 @@ static void test_submodel(void)
 {
     fs_config cfg = strip_config();
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 450, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     grow_crack(&w, 3);
@@ -462,7 +423,7 @@ static void test_smooth_distorted(void)
 {
     fs_config cfg = strip_config();
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 450, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
     /* the node nearest the centre, pulled 60 % of the way to its first neighbour */
     int32_t node = 0;
     for (int32_t i = 1; i < m.n_nodes; i++)
@@ -507,7 +468,7 @@ static void test_smooth_tip(void)
 {
     fs_config cfg = strip_config();
     fs_mesh m = {0};
-    CHECK(make_mesh(&cfg, 450, &m) == 0);
+    CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     grow_crack(&w, 3);
@@ -581,7 +542,7 @@ static void test_simulation(void)
             cfg.mesh.smooth_radius = 3.0;
         }
         fs_mesh m = {0};
-        CHECK(make_mesh(&cfg, 450, &m) == 0);
+        CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
         fs_wedge_model w;
         CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
         CHECK(fs_wedge_simulate(&w, 0.3) == 0);
