@@ -681,8 +681,6 @@ static void assemble_coupled(int32_t m, const double c[9], fs_sparse_matrix *a)
     fs_sparse_matrix_free(&p);
 }
 
-/* The 3x3 block preconditioner solves to the same tolerance in fewer iterations than Jacobi when the
- * three unknowns of a point are coupled, and reports a block that is not positive definite. */
 /* The max_residual rule stops once no entry of b - A x exceeds the bound, and sooner than the
  * Euclidean rule with the same bound on the whole vector. */
 static void test_cg_max_residual(void)
@@ -720,6 +718,8 @@ static void test_cg_max_residual(void)
     free(ax);
 }
 
+/* The 3x3 block preconditioner solves to the same tolerance in fewer iterations than Jacobi when the
+ * three unknowns of a point are coupled, and reports a block that is not positive definite. */
 static void test_cg_block_preconditioner(void)
 {
     enum { m = 20, n = 3 * m * m };
