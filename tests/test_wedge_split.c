@@ -223,10 +223,77 @@ static double csc_entry(const fs_sparse_matrix *k, int32_t row, int32_t col)
     return 0.0;
 }
 
-/* The stiffness matrix the cuts extended in place (fs_wedge_apply_change) is well formed (rows
- * strictly ascending in every column, which ends on its diagonal) and equals a fresh assembly of the
- * cut mesh: every entry of the fresh one with the same value, every other stored entry zero; with
- * growth that moves the fixed bottom nodes, so the fixed columns are exercised too. */
+/* The model's whole system as one upper CSC of order n_free + n_fixed: K_ff and K_fb (fixed column
+ * n_free + k). */
+static void whole_system(const fs_wedge_model *w, fs_sparse_matrix *out)
+{
+    const fs_sparse_matrix *k = &w->k_free;
+    const fs_wedge_coupling *c = &w->k_fb;
+    fs_sparse_builder b;
+    fs_sparse_builder_init(&b, w->n_free + w->n_fixed, 0);
+    for (int32_t j = 0; j < k->n; j++)
+        for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++)
+            fs_sparse_builder_add(&b, k->row_idx[p], j, k->values[p]);
+    for (int32_t col = 0; col < c->n; col++)
+        for (int32_t p = c->start[col]; p < c->start[col] + c->len[col]; p++)
+            fs_sparse_builder_add(&b, c->row[p], w->n_free + col, c->value[p]);
+    CHECK(fs_sparse_builder_compress(&b, out, NULL) == 0);
+    fs_sparse_builder_free(&b);
+}
+
+/* The model's system, extended in place by its changes, is well formed (K_ff: rows strictly ascending
+ * in every column, which ends on its diagonal; K_fb: free rows strictly ascending in every column,
+ * within its room in the pool) and equals a fresh assembly of the changed mesh: every entry of the
+ * fresh one with the same value, every other stored entry zero. Re-assembles w. */
+static void check_system_is_fresh(fs_wedge_model *w)
+{
+    const fs_sparse_matrix *kf = &w->k_free;
+    const fs_wedge_coupling *c = &w->k_fb;
+    int32_t bad = 0;
+    for (int32_t j = 0; j < kf->n; j++) {
+        for (int32_t p = kf->col_ptr[j]; p + 1 < kf->col_ptr[j + 1]; p++)
+            bad += kf->row_idx[p] >= kf->row_idx[p + 1];
+        bad += kf->col_ptr[j + 1] == kf->col_ptr[j] || kf->row_idx[kf->col_ptr[j + 1] - 1] != j;
+    }
+    CHECK(kf->n == w->n_free && c->n == w->n_fixed && c->used <= c->size);
+    for (int32_t col = 0; col < c->n; col++) {
+        bad += c->len[col] > c->cap[col] || (size_t)c->start[col] + (size_t)c->cap[col] > c->used;
+        for (int32_t p = c->start[col]; p < c->start[col] + c->len[col]; p++)
+            bad += c->row[p] < 0 || c->row[p] >= w->n_free || (p > c->start[col] && c->row[p - 1] >= c->row[p]);
+    }
+    CHECK_MSG(bad == 0, "%d malformed columns", (int)bad);
+    fs_sparse_matrix old, fresh;
+    whole_system(w, &old);
+    int32_t order = old.n;
+    uint8_t *none = calloc((size_t)w->n_nodes + 1, 1);
+    CHECK(fs_wedge_pin_top(w, none) == 0); /* the same numbering, assembled afresh */
+    free(none);
+    whole_system(w, &fresh);
+    CHECK(fresh.n == order);
+    double scale = 0.0, worst = 0.0;
+    for (int32_t p = 0; p < fs_sparse_matrix_nnz(&old); p++)
+        scale = fmax(scale, fabs(old.values[p]));
+    int32_t missing = 0;
+    for (int32_t j = 0; j < order && fresh.n == order; j++) {
+        for (int32_t p = fresh.col_ptr[j]; p < fresh.col_ptr[j + 1]; p++) {
+            int32_t i = fresh.row_idx[p];
+            bool stored = false;
+            for (int32_t q = old.col_ptr[j]; q < old.col_ptr[j + 1]; q++)
+                stored |= old.row_idx[q] == i;
+            missing += !stored && fresh.values[p] != 0.0;
+            worst = fmax(worst, fabs(fresh.values[p] - csc_entry(&old, i, j)));
+        }
+        for (int32_t q = old.col_ptr[j]; q < old.col_ptr[j + 1]; q++)
+            worst = fmax(worst, fabs(old.values[q] - csc_entry(&fresh, old.row_idx[q], j)));
+    }
+    CHECK_MSG(missing == 0, "%d fresh entries missing from the extended matrix", (int)missing);
+    CHECK_MSG(worst <= 1e-12 * scale, "extended and fresh matrices differ by %.3g of %.3g", worst, scale);
+    fs_sparse_matrix_free(&old);
+    fs_sparse_matrix_free(&fresh);
+}
+
+/* The cuts extend the system in place correctly; with growth that moves the fixed bottom nodes, so
+ * the coupling is exercised too. */
 static void test_extended_matrix_is_fresh(void)
 {
     fs_config cfg = wedge_strip_config();
@@ -237,44 +304,60 @@ static void test_extended_matrix_is_fresh(void)
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     CHECK(fs_wedge_simulate(&w, 1.0) == 0);
     CHECK_MSG(w.fractures >= 10, "%lld splits", (long long)w.fractures);
-    fs_sparse_matrix *k = &w.k_all;
-    int32_t order = k->n, bad = 0;
-    for (int32_t j = 0; j < order; j++) {
-        for (int32_t p = k->col_ptr[j]; p + 1 < k->col_ptr[j + 1]; p++)
-            bad += k->row_idx[p] >= k->row_idx[p + 1];
-        bad += k->col_ptr[j + 1] == k->col_ptr[j] || k->row_idx[k->col_ptr[j + 1] - 1] != j;
-    }
-    CHECK_MSG(bad == 0, "%d malformed columns", (int)bad);
-    fs_sparse_matrix old = {order, malloc(((size_t)order + 1) * sizeof(int32_t)), NULL, NULL};
-    int32_t nnz = k->col_ptr[order];
-    old.row_idx = malloc((size_t)nnz * sizeof(int32_t));
-    old.values = malloc((size_t)nnz * sizeof(double));
-    memcpy(old.col_ptr, k->col_ptr, ((size_t)order + 1) * sizeof(int32_t));
-    memcpy(old.row_idx, k->row_idx, (size_t)nnz * sizeof(int32_t));
-    memcpy(old.values, k->values, (size_t)nnz * sizeof(double));
-    uint8_t *none = calloc((size_t)w.n_nodes + 1, 1);
-    CHECK(fs_wedge_pin_top(&w, none) == 0); /* the same numbering, assembled afresh */
-    free(none);
-    CHECK(k->n == order);
-    double scale = 0.0, worst = 0.0;
-    for (int32_t p = 0; p < nnz; p++)
-        scale = fmax(scale, fabs(old.values[p]));
-    int32_t missing = 0;
-    for (int32_t j = 0; j < order && k->n == order; j++) {
-        for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++) {
-            int32_t i = k->row_idx[p];
-            bool stored = false;
-            for (int32_t q = old.col_ptr[j]; q < old.col_ptr[j + 1]; q++)
-                stored |= old.row_idx[q] == i;
-            missing += !stored && k->values[p] != 0.0;
-            worst = fmax(worst, fabs(k->values[p] - csc_entry(&old, i, j)));
+    check_system_is_fresh(&w);
+    fs_wedge_free(&w);
+    fs_mesh_free(&m);
+}
+
+/* Twice the signed area of the triangle of nodes a, b, c (the plane: z ignored). */
+static double orientation(const fs_mesh *m, int32_t a, int32_t b, int32_t c)
+{
+    const double *p = m->pos + 3 * (size_t)a, *q = m->pos + 3 * (size_t)b, *r = m->pos + 3 * (size_t)c;
+    return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+}
+
+/* A change that couples old nodes not coupled before (an edge flip: cuts and bisections never do)
+ * adds entries to old columns of K_ff, which moves the columns behind them: the system still equals
+ * a fresh assembly. */
+static void test_flip_extends_old_columns(void)
+{
+    fs_config cfg = wedge_strip_config();
+    cfg.domain.periodic_x = cfg.domain.periodic_y = false;
+    fs_mesh m = {0};
+    CHECK(wedge_test_mesh(&cfg, 600, &m) == 0);
+    fs_wedge_model w;
+    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_equilibrium(&w, 0.5) == 0);
+    int flips = 0;
+    for (int32_t t = 0; t < m.n_tris && flips < 3; t += 37) {
+        for (int i = 0; i < 3; i++) {
+            int32_t u = m.adj[3 * (size_t)t + i];
+            if (u < 0 || u == t)
+                continue;
+            int32_t a = m.tri[3 * (size_t)t + i], b = m.tri[3 * (size_t)t + (i + 1) % 3];
+            int32_t c = m.tri[3 * (size_t)t + (i + 2) % 3], d = -1;
+            for (int k = 0; k < 3; k++)
+                if (m.tri[3 * (size_t)u + k] != a && m.tri[3 * (size_t)u + k] != b)
+                    d = m.tri[3 * (size_t)u + k];
+            /* the quadrilateral a d b c must be convex for the flip to (a, d, c), (d, b, c) */
+            if (d < 0 || orientation(&m, a, d, c) <= 0.0 || orientation(&m, d, b, c) <= 0.0)
+                continue;
+            int32_t ta[3] = {a, d, c}, tb[3] = {d, b, c};
+            memcpy(m.tri + 3 * (size_t)t, ta, sizeof ta);
+            memcpy(m.tri + 3 * (size_t)u, tb, sizeof tb);
+            fs_mesh_drop_derived(&m);
+            CHECK(fs_mesh_build_adjacency(&m) == 0);
+            fs_mesh_build_edges(&m);
+            fs_mesh_build_rings(&m);
+            int32_t changed[2] = {t < u ? t : u, t < u ? u : t};
+            fs_wedge_change ch = {m.n_nodes, m.n_tris, NULL, NULL, NULL, changed, 2};
+            CHECK(fs_wedge_apply_change(&w, &ch) == 0);
+            flips++;
+            break;
         }
-        for (int32_t q = old.col_ptr[j]; q < old.col_ptr[j + 1]; q++)
-            worst = fmax(worst, fabs(old.values[q] - csc_entry(k, old.row_idx[q], j)));
     }
-    CHECK_MSG(missing == 0, "%d fresh entries missing from the extended matrix", (int)missing);
-    CHECK_MSG(worst <= 1e-12 * scale, "extended and fresh matrices differ by %.3g of %.3g", worst, scale);
-    fs_sparse_matrix_free(&old);
+    CHECK_MSG(flips == 3, "%d flips", flips);
+    check_system_is_fresh(&w);
     fs_wedge_free(&w);
     fs_mesh_free(&m);
 }
@@ -310,5 +393,6 @@ int main(void)
     RUN(test_crack_perpendicular);
     RUN(test_griffith);
     RUN(test_extended_matrix_is_fresh);
+    RUN(test_flip_extends_old_columns);
     return check_finish();
 }

@@ -175,20 +175,18 @@ static double max_residual(const fs_wedge_model *w, double *tau)
     for (int32_t i = 0; i < nf; i++)
         for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
             f[i] += coef[q] * w->load[(size_t)q * nf + i];
-    const fs_sparse_matrix *k = &w->k_all;
-    for (int32_t j = 0; j < nf + w->n_fixed; j++)
+    const fs_sparse_matrix *k = &w->k_free;
+    for (int32_t j = 0; j < nf; j++)
         for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++) {
             int32_t i = k->row_idx[p];
-            double v = k->values[p];
-            if (j >= nf) {
-                if (i < nf) /* not the fixed column's own (zero) diagonal */
-                    f[i] -= v * w->u_fixed[j - nf];
-            } else {
-                ku[i] += v * x[j];
-                if (i != j)
-                    ku[j] += v * x[i];
-            }
+            ku[i] += k->values[p] * x[j];
+            if (i != j)
+                ku[j] += k->values[p] * x[i];
         }
+    const fs_wedge_coupling *c = &w->k_fb;
+    for (int32_t col = 0; col < c->n; col++)
+        for (int32_t p = c->start[col]; p < c->start[col] + c->len[col]; p++)
+            f[c->row[p]] -= c->value[p] * w->u_fixed[col];
     double worst = 0.0, f2 = 0.0;
     for (int32_t i = 0; i < nf; i++) {
         worst = fmax(worst, fabs(f[i] - ku[i]));

@@ -307,6 +307,164 @@ static int32_t find_entry(const fs_sparse_matrix *m, int32_t i, int32_t j)
     return -1;
 }
 
+/* ---- the coupling K_fb (see fs_wedge_coupling) ---- */
+
+/* Room a column is given beyond its entries when it is laid out or moved: a cut adds a few rows. */
+#define COUPLING_SLACK 6
+
+static void coupling_free(fs_wedge_coupling *c)
+{
+    free(c->start);
+    free(c->len);
+    free(c->cap);
+    free(c->row);
+    free(c->value);
+    memset(c, 0, sizeof *c);
+}
+
+/* Makes room for `more` slots at the end of the pool. */
+static void coupling_reserve(fs_wedge_coupling *c, size_t more)
+{
+    if (c->used + more <= c->size)
+        return;
+    c->size = 2 * (c->used + more);
+    c->row = fs_realloc(c->row, c->size * sizeof *c->row);
+    c->value = fs_realloc(c->value, c->size * sizeof *c->value);
+}
+
+/* Grows the column arrays to n columns; new columns are empty with room for COUPLING_SLACK. */
+static void coupling_resize(fs_wedge_coupling *c, int32_t n)
+{
+    c->start = fs_realloc(c->start, ((size_t)n + 1) * sizeof *c->start);
+    c->len = fs_realloc(c->len, ((size_t)n + 1) * sizeof *c->len);
+    c->cap = fs_realloc(c->cap, ((size_t)n + 1) * sizeof *c->cap);
+    coupling_reserve(c, (size_t)COUPLING_SLACK * (size_t)(n > c->n ? n - c->n : 0));
+    for (int32_t k = c->n; k < n; k++) {
+        c->start[k] = (int32_t)c->used;
+        c->len[k] = 0;
+        c->cap[k] = COUPLING_SLACK;
+        c->used += COUPLING_SLACK;
+    }
+    c->n = n;
+}
+
+/* The coupling from the fixed columns nf .. a->n - 1 of an upper CSC (their free rows; the fixed
+ * columns' own zero diagonals are left out). */
+static void coupling_from_csc(fs_wedge_coupling *c, const fs_sparse_matrix *a, int32_t nf)
+{
+    coupling_free(c);
+    int32_t n = a->n - nf;
+    size_t total = 0;
+    for (int32_t j = nf; j < a->n; j++)
+        total += (size_t)(a->col_ptr[j + 1] - a->col_ptr[j]) + COUPLING_SLACK;
+    c->size = total + 1;
+    c->row = fs_malloc(c->size * sizeof *c->row);
+    c->value = fs_malloc(c->size * sizeof *c->value);
+    c->start = fs_malloc(((size_t)n + 1) * sizeof *c->start);
+    c->len = fs_malloc(((size_t)n + 1) * sizeof *c->len);
+    c->cap = fs_malloc(((size_t)n + 1) * sizeof *c->cap);
+    for (int32_t k = 0; k < n; k++) {
+        int32_t j = nf + k, m = 0;
+        c->start[k] = (int32_t)c->used;
+        for (int32_t p = a->col_ptr[j]; p < a->col_ptr[j + 1]; p++)
+            if (a->row_idx[p] < nf) {
+                c->row[c->used + (size_t)m] = a->row_idx[p];
+                c->value[c->used + (size_t)m++] = a->values[p];
+            }
+        c->len[k] = m;
+        c->cap[k] = m + COUPLING_SLACK;
+        c->used += (size_t)c->cap[k];
+    }
+    c->n = n;
+}
+
+/* The slot of (row, column k), or where it would go (the first slot with a larger row) as
+ * -1 - position. */
+static int32_t coupling_search(const fs_wedge_coupling *c, int32_t k, int32_t row)
+{
+    int32_t lo = c->start[k], hi = c->start[k] + c->len[k];
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (c->row[mid] < row)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < c->start[k] + c->len[k] && c->row[lo] == row ? lo : -1 - lo;
+}
+
+/* Adds (row, column k) with value 0 unless present. A full column moves to the end of the pool with
+ * twice the room; when holes fill half the pool it is laid out afresh. */
+static void coupling_insert(fs_wedge_coupling *c, int32_t k, int32_t row)
+{
+    int32_t at = coupling_search(c, k, row);
+    if (at >= 0)
+        return;
+    at = -1 - at;
+    if (c->len[k] == c->cap[k]) {
+        int32_t cap = 2 * c->cap[k] + COUPLING_SLACK, offset = at - c->start[k];
+        coupling_reserve(c, (size_t)cap);
+        memcpy(c->row + c->used, c->row + c->start[k], (size_t)c->len[k] * sizeof *c->row);
+        memcpy(c->value + c->used, c->value + c->start[k], (size_t)c->len[k] * sizeof *c->value);
+        c->start[k] = (int32_t)c->used;
+        c->cap[k] = cap;
+        c->used += (size_t)cap;
+        at = c->start[k] + offset;
+    }
+    int32_t end = c->start[k] + c->len[k];
+    memmove(c->row + at + 1, c->row + at, (size_t)(end - at) * sizeof *c->row);
+    memmove(c->value + at + 1, c->value + at, (size_t)(end - at) * sizeof *c->value);
+    c->row[at] = row;
+    c->value[at] = 0.0;
+    c->len[k]++;
+}
+
+/* Lays the pool out afresh (each column with COUPLING_SLACK room) once moved columns' holes take
+ * more than half of it. */
+static void coupling_compact(fs_wedge_coupling *c)
+{
+    size_t live = 0;
+    for (int32_t k = 0; k < c->n; k++)
+        live += (size_t)c->len[k] + COUPLING_SLACK;
+    if (2 * live >= c->used)
+        return;
+    int32_t *row = fs_malloc((live + 1) * sizeof *row);
+    double *value = fs_malloc((live + 1) * sizeof *value);
+    size_t at = 0;
+    for (int32_t k = 0; k < c->n; k++) {
+        memcpy(row + at, c->row + c->start[k], (size_t)c->len[k] * sizeof *row);
+        memcpy(value + at, c->value + c->start[k], (size_t)c->len[k] * sizeof *value);
+        c->start[k] = (int32_t)at;
+        c->cap[k] = c->len[k] + COUPLING_SLACK;
+        at += (size_t)c->cap[k];
+    }
+    free(c->row);
+    free(c->value);
+    c->row = row;
+    c->value = value;
+    c->used = at;
+    c->size = live + 1;
+}
+
+/* The slot of the system entry coupling DOFs i and j (not both fixed): in k_free, or in k_fb for a
+ * fixed one; *in_fb tells which. -1 if not stored. */
+static int32_t system_slot(const fs_wedge_model *w, int32_t i, int32_t j, bool *in_fb)
+{
+    int32_t row = i < j ? i : j, col = i < j ? j : i;
+    *in_fb = col >= w->n_free;
+    if (!*in_fb)
+        return find_entry(&w->k_free, row, col);
+    int32_t p = coupling_search(&w->k_fb, col - w->n_free, row);
+    return p >= 0 ? p : -1;
+}
+
+double fs_wedge_system_entry(const fs_wedge_model *w, int32_t g, int32_t j)
+{
+    bool in_fb;
+    int32_t p = system_slot(w, g, j, &in_fb);
+    return p < 0 ? 0.0 : in_fb ? w->k_fb.value[p] : w->k_free.values[p];
+}
+
 /* Calls add(ctx, i, j, value) for every kept pair (a <= c) of the element: fixed-fixed pairs are left
  * out; two local DOFs on one global DOF (a node repeated in a tiny periodic mesh) add the
  * off-diagonal term twice, as the full matrix would. */
@@ -352,20 +510,12 @@ static void fix_orphans(fs_wedge_model *w)
         for (int k = 3; k < 6; k++) {
             int32_t g = w->dof[6 * (size_t)i + k];
             if (g < w->n_free) {
-                int32_t p = find_entry(&w->k_all, g, g);
+                int32_t p = find_entry(&w->k_free, g, g);
                 FS_ASSERT(p >= 0);
-                w->k_all.values[p] = 1.0;
+                w->k_free.values[p] = 1.0;
             }
         }
     }
-}
-
-static void set_view(fs_wedge_model *w)
-{
-    w->k_free.n = w->n_free;
-    w->k_free.col_ptr = w->k_all.col_ptr;
-    w->k_free.row_idx = w->k_all.row_idx;
-    w->k_free.values = w->k_all.values;
 }
 
 static int factorize(fs_wedge_model *w, bool analyze)
@@ -392,10 +542,11 @@ static int factorize(fs_wedge_model *w, bool analyze)
 }
 
 /* design: thesis §5.4 assembles K_G from every element and §5.5 eliminates the known (fixed) nodal
- * coordinates from the system (its second approach), which halves the unknowns. All DOFs go into one
- * symmetric matrix numbered free-first, without fixed-fixed pairs: its leading block is K_ff, which
- * the solvers see through a view without a copy, and its other columns hold K_fb, which turns the
- * prescribed motion of fixed nodes into the right-hand side -K_fb u_b. */
+ * coordinates from the system (its second approach), which halves the unknowns. All DOFs are
+ * assembled into one symmetric matrix numbered free-first, without fixed-fixed pairs: its leading
+ * block is K_ff, which the solvers use as it lies, and its other columns become K_fb (a coupling with
+ * room to grow, fs_wedge_coupling), which turns the prescribed motion of fixed nodes into the
+ * right-hand side -K_fb u_b. */
 static int build_system(fs_wedge_model *w)
 {
     double t0 = fs_seconds();
@@ -423,13 +574,20 @@ static int build_system(fs_wedge_model *w)
     /* every free DOF keeps a diagonal entry, orphans included */
     for (int32_t g = 0; g < w->n_free; g++)
         fs_sparse_builder_add(&b, g, g, 0.0);
-    fs_sparse_matrix_free(&w->k_all);
-    int rc = fs_sparse_builder_compress(&b, &w->k_all, NULL);
+    fs_sparse_matrix all = {0};
+    int rc = fs_sparse_builder_compress(&b, &all, NULL);
     fs_sparse_builder_free(&b);
     if (rc < 0)
         return -1;
-    w->k_all_capacity = (size_t)fs_sparse_matrix_nnz(&w->k_all);
-    set_view(w);
+    /* the leading block is K_ff as it stands; the fixed columns go into K_fb */
+    coupling_from_csc(&w->k_fb, &all, w->n_free);
+    fs_sparse_matrix_free(&w->k_free);
+    w->k_free = all;
+    w->k_free.n = w->n_free;
+    w->k_free_capacity = (size_t)fs_sparse_matrix_nnz(&w->k_free) + 1;
+    w->k_free.row_idx = fs_realloc(w->k_free.row_idx, w->k_free_capacity * sizeof *w->k_free.row_idx);
+    w->k_free.values = fs_realloc(w->k_free.values, w->k_free_capacity * sizeof *w->k_free.values);
+    w->k_free.col_ptr = fs_realloc(w->k_free.col_ptr, ((size_t)w->n_free + 1) * sizeof *w->k_free.col_ptr);
     fix_orphans(w);
     w->rhs = fs_realloc(w->rhs, ((size_t)w->n_free + 1) * sizeof *w->rhs);
     w->x = fs_realloc(w->x, ((size_t)w->n_free + 1) * sizeof *w->x);
@@ -444,7 +602,7 @@ static int build_system(fs_wedge_model *w)
 }
 
 typedef struct {
-    fs_sparse_matrix *m;
+    fs_wedge_model *w;
     const uint8_t *only; /* if not NULL: add only where both DOFs are marked */
 } refill_ctx;
 
@@ -453,9 +611,13 @@ static void add_in_place(void *ctx, int32_t i, int32_t j, double v)
     refill_ctx *r = ctx;
     if (r->only && !(r->only[i] && r->only[j]))
         return;
-    int32_t p = find_entry(r->m, i, j);
+    bool in_fb;
+    int32_t p = system_slot(r->w, i, j, &in_fb);
     FS_ASSERT(p >= 0);
-    r->m->values[p] += v;
+    if (in_fb)
+        r->w->k_fb.value[p] += v;
+    else
+        r->w->k_free.values[p] += v;
 }
 
 /* Re-adds the contributions of the living elements in `elems` (ascending) into the pattern: all of
@@ -463,7 +625,7 @@ static void add_in_place(void *ctx, int32_t i, int32_t j, double v)
 static int readd(fs_wedge_model *w, const int32_t *elems, int32_t n, const uint8_t *only)
 {
     double K[324], loads[FS_WEDGE_PATTERNS][18];
-    refill_ctx r = {&w->k_all, only};
+    refill_ctx r = {w, only};
     for (int32_t q = 0; q < n; q++) {
         int32_t e = elems ? elems[q] : q;
         if (w->state[e] != FS_WEDGE_ALIVE)
@@ -482,7 +644,9 @@ static int refill_system(fs_wedge_model *w, double base_thickness)
 {
     double t0 = fs_seconds();
     w->assembled_thickness = base_thickness;
-    fs_sparse_matrix_zero(&w->k_all);
+    fs_sparse_matrix_zero(&w->k_free);
+    for (size_t p = 0; p < w->k_fb.used; p++)
+        w->k_fb.value[p] = 0.0;
     memset(w->load, 0, (size_t)FS_WEDGE_PATTERNS * w->n_free * sizeof *w->load);
     if (readd(w, NULL, w->n_elems, NULL) < 0 || refresh_cache(w, NULL, w->n_elems) < 0)
         return -1;
@@ -526,16 +690,13 @@ void fs_wedge_build_rhs(fs_wedge_model *w)
             s += coef[q] * w->load[(size_t)q * nf + i];
         w->rhs[i] = s;
     }
-    const fs_sparse_matrix *k = &w->k_all;
-    for (int32_t j = nf; j < nf + w->n_fixed; j++) {
-        double uj = w->u_fixed[j - nf];
-        if (uj == 0.0)
+    const fs_wedge_coupling *c = &w->k_fb;
+    for (int32_t k = 0; k < c->n; k++) {
+        double uk = w->u_fixed[k];
+        if (uk == 0.0)
             continue;
-        for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++) {
-            int32_t r = k->row_idx[p];
-            if (r < nf)
-                w->rhs[r] -= k->values[p] * uj;
-        }
+        for (int32_t p = c->start[k]; p < c->start[k] + c->len[k]; p++)
+            w->rhs[c->row[p]] -= c->value[p] * uk;
     }
 }
 
@@ -1161,7 +1322,8 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->node_elem_start);
     free(w->node_elem);
     free(w->node_elem_count);
-    fs_sparse_matrix_free(&w->k_all);
+    fs_sparse_matrix_free(&w->k_free);
+    coupling_free(&w->k_fb);
     free(w->load);
     free(w->rhs);
     free(w->x);
@@ -1206,15 +1368,22 @@ static int update_region(fs_wedge_model *w, const int32_t *nodes, int32_t n)
                 dofs[nd++] = g;
             }
         }
-    fs_sparse_matrix *k = &w->k_all;
+    fs_sparse_matrix *k = &w->k_free;
+    fs_wedge_coupling *c = &w->k_fb;
     for (int32_t q = 0; q < nd; q++) {
         int32_t j = dofs[q];
+        if (j >= w->n_free) {
+            int32_t col = j - w->n_free;
+            for (int32_t p = c->start[col]; p < c->start[col] + c->len[col]; p++)
+                if (w->mark[c->row[p]])
+                    c->value[p] = 0.0;
+            continue;
+        }
         for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++)
             if (w->mark[k->row_idx[p]])
                 k->values[p] = 0.0;
-        if (j < w->n_free)
-            for (int pat = 0; pat < FS_WEDGE_PATTERNS; pat++)
-                w->load[(size_t)pat * w->n_free + j] = 0.0;
+        for (int pat = 0; pat < FS_WEDGE_PATTERNS; pat++)
+            w->load[(size_t)pat * w->n_free + j] = 0.0;
     }
     int32_t cap = 0, ne = 0;
     for (int32_t q = 0; q < n; q++)
@@ -1382,13 +1551,17 @@ int fs_wedge_remove(fs_wedge_model *w, int32_t e)
     return update_factor_after_removal(w, K, g, orphans, n_orphans);
 }
 
-/* design: the new pattern after a subdivision is the old one plus the pairs of the changed and new
- * elements. New nodes are appended and the DOFs keep their order (free ones in node order, then the
- * fixed ones), so old indices map monotonically into the new numbering (free DOFs stay, fixed ones
- * move up by the number of new free DOFs) and each column of the new matrix is a merge of the mapped
- * old column with the sorted new rows. Entries whose element vanished stay in the pattern as zeros.
- * Values are copied and then rebuilt around the changed nodes (update_region), so nothing is
- * assembled twice; the pattern changed, so the factor is analysed and computed afresh. */
+/* design: the system is extended in place after a subdivision or a cut. New nodes are appended and
+ * number_dofs keeps the order of the old DOFs (free ones in node order, then the fixed ones), so old
+ * free indices stay and every fixed DOF keeps its column of K_fb. K_ff's new pattern is the old one
+ * plus the pairs of the changed elements it lacks and the diagonals of the new DOFs. A cut or a
+ * bisection couples old nodes only where they were coupled already, so those pairs are in the new
+ * nodes' columns, which come last: the old columns stay where they are. A pair of old nodes not
+ * coupled before (a collapsed edge) moves the columns behind it, by a merge from the back that never
+ * overwrites an entry not yet read. K_fb's new entries go into their columns in place
+ * (fs_wedge_coupling). The arrays grow geometrically, so a cut costs what its elements touch, not a
+ * pass over the matrix. Entries whose element vanished stay in the pattern as zeros; new entries are
+ * 0 (update_region adds the contributions); the pattern changed, so the factor is analysed afresh. */
 static int cmp_int64(const void *a, const void *b)
 {
     int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
@@ -1404,36 +1577,23 @@ static void push_pair(int64_t **pairs, size_t *np, size_t *cap, int64_t key)
     (*pairs)[(*np)++] = key;
 }
 
-/* The old column of new column j after n_new free DOFs were inserted at n_free_old (-1: a new one). */
-static int32_t old_column(int32_t j, int32_t n_free_old, int32_t n_fixed_old, int32_t nf)
+/* Grows an array of n_old elements of the given size to n, zeroing the new ones. */
+static void *grow_zeroed(void *a, size_t n_old, size_t n, size_t size)
 {
-    if (j < n_free_old)
-        return j;
-    if (j >= nf && j - nf < n_fixed_old)
-        return n_free_old + (j - nf);
-    return -1;
-}
-
-/* design: the matrix is extended in place. The new pattern is the old one plus the (sorted, possibly
- * repeated, possibly present) pairs of the changed elements and the diagonals of the new DOFs. Old free
- * rows keep their indices (a free column holds rows no larger than itself; a fixed column holds free
- * rows and its own zero diagonal, whose index moves up with the column, see new_row), so every old
- * column moves as a block to a position no lower than before: one counting pass fixes the new column
- * starts, then the columns are moved from the last to the first, unchanged runs by memmove and columns
- * with new pairs by a merge from the back, which never overwrites an entry not yet read. The arrays
- * grow geometrically, so a cut costs one pass over the entries behind its first changed column and no
- * allocation. New entries are 0 (update_region adds the contributions). */
-
-/* The new index of old row r (a fixed index moves up by the number of new free DOFs). */
-static inline int64_t new_row(int32_t r, int32_t n_free_old, int32_t shift)
-{
-    return r < n_free_old ? r : (int64_t)r + shift;
+    a = fs_realloc(a, (n ? n : 1) * size);
+    if (n > n_old)
+        memset((char *)a + n_old * size, 0, (n - n_old) * size);
+    return a;
 }
 
 static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_old, const int32_t *elems,
                          int32_t n_changed)
 {
-    int32_t nf = w->n_free, order = w->n_free + w->n_fixed, shift = nf - n_free_old;
+    int32_t nf = w->n_free;
+    FS_ASSERT(nf >= n_free_old && w->n_fixed >= n_fixed_old && w->k_fb.n == n_fixed_old);
+    fs_sparse_matrix *k = &w->k_free;
+    fs_wedge_coupling *c = &w->k_fb;
+    coupling_resize(c, w->n_fixed);
     size_t cap = 0, np = 0;
     int64_t *pairs = NULL;
     for (int32_t q = 0; q < n_changed; q++) {
@@ -1444,43 +1604,45 @@ static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_
         for (int a = 0; a < 18; a++)
             g[a] = elem_dof(w, e, a);
         for (int a = 0; a < 18; a++)
-            for (int c = a; c < 18; c++) {
-                if (g[a] >= nf && g[c] >= nf)
-                    continue;
-                int32_t row = g[a] < g[c] ? g[a] : g[c], col = g[a] < g[c] ? g[c] : g[a];
-                push_pair(&pairs, &np, &cap, (int64_t)col * order + row);
+            for (int b = a; b < 18; b++) {
+                int32_t row = g[a] < g[b] ? g[a] : g[b], col = g[a] < g[b] ? g[b] : g[a];
+                if (row >= nf)
+                    continue; /* fixed-fixed */
+                if (col >= nf)
+                    coupling_insert(c, col - nf, row);
+                else if (col >= n_free_old || find_entry(k, row, col) < 0)
+                    push_pair(&pairs, &np, &cap, (int64_t)col * nf + row);
             }
     }
-    for (int32_t j = 0; j < order; j++) /* diagonals of the new columns */
-        if (old_column(j, n_free_old, n_fixed_old, nf) < 0)
-            push_pair(&pairs, &np, &cap, (int64_t)j * order + j);
+    coupling_compact(c);
+    for (int32_t j = n_free_old; j < nf; j++) /* diagonals of the new columns */
+        push_pair(&pairs, &np, &cap, (int64_t)j * nf + j);
+    if (np == 0) {
+        free(pairs);
+        goto vectors;
+    }
     qsort(pairs, np, sizeof *pairs, cmp_int64);
 
-    fs_sparse_matrix *k = &w->k_all;
-    /* pass 1: the new column starts; pair_start[j] indexes the first pair of column j */
-    int32_t *ptr = fs_malloc(((size_t)order + 1) * sizeof *ptr);
-    size_t *pair_start = fs_malloc(((size_t)order + 1) * sizeof *pair_start);
-    size_t nz = 0, pp = 0;
-    for (int32_t j = 0; j < order; j++) {
-        int32_t jo = old_column(j, n_free_old, n_fixed_old, nf);
-        int32_t po = jo >= 0 ? k->col_ptr[jo] : 0, po_end = jo >= 0 ? k->col_ptr[jo + 1] : 0;
-        ptr[j] = (int32_t)(nz <= INT32_MAX ? nz : INT32_MAX);
-        pair_start[j] = pp;
-        if (pp == np || pairs[pp] / order != j) {
-            nz += (size_t)(po_end - po);
-            continue;
-        }
-        while (po < po_end || (pp < np && pairs[pp] / order == j)) {
-            int64_t r_old = po < po_end ? new_row(k->row_idx[po], n_free_old, shift) : INT64_MAX;
-            int64_t r_new = pp < np && pairs[pp] / order == j ? pairs[pp] % order : INT64_MAX;
+    /* pass 1: the new starts of columns first .. nf - 1 (those before the first new pair stay) */
+    int32_t first = (int32_t)(pairs[0] / nf), span = nf - first;
+    int32_t *ptr = fs_malloc(((size_t)span + 1) * sizeof *ptr);
+    size_t *pair_start = fs_malloc(((size_t)span + 1) * sizeof *pair_start);
+    size_t nz = (size_t)k->col_ptr[first < n_free_old ? first : n_free_old], pp = 0;
+    for (int32_t j = first; j < nf; j++) {
+        int32_t po = j < n_free_old ? k->col_ptr[j] : 0, po_end = j < n_free_old ? k->col_ptr[j + 1] : 0;
+        ptr[j - first] = (int32_t)(nz <= INT32_MAX ? nz : INT32_MAX);
+        pair_start[j - first] = pp;
+        while (po < po_end || (pp < np && pairs[pp] / nf == j)) {
+            int64_t r_old = po < po_end ? k->row_idx[po] : INT64_MAX;
+            int64_t r_new = pp < np && pairs[pp] / nf == j ? pairs[pp] % nf : INT64_MAX;
             int64_t r = r_old < r_new ? r_old : r_new;
             po += r_old == r;
-            while (pp < np && pairs[pp] / order == j && pairs[pp] % order == r)
+            while (pp < np && pairs[pp] / nf == j && pairs[pp] % nf == r)
                 pp++;
             nz++;
         }
     }
-    pair_start[order] = np;
+    pair_start[span] = np;
     if (nz > INT32_MAX) {
         free(pairs);
         free(ptr);
@@ -1488,65 +1650,60 @@ static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_
         fs_error(FS_ERR_INTERNAL, "wedge model: the stiffness matrix outgrew 32-bit indices");
         return -1;
     }
-    ptr[order] = (int32_t)nz;
-    if (nz > w->k_all_capacity) {
-        w->k_all_capacity = nz + nz / 2;
-        k->row_idx = fs_realloc(k->row_idx, w->k_all_capacity * sizeof *k->row_idx);
-        k->values = fs_realloc(k->values, w->k_all_capacity * sizeof *k->values);
+    ptr[span] = (int32_t)nz;
+    if (nz > w->k_free_capacity) {
+        w->k_free_capacity = nz + nz / 2;
+        k->row_idx = fs_realloc(k->row_idx, w->k_free_capacity * sizeof *k->row_idx);
+        k->values = fs_realloc(k->values, w->k_free_capacity * sizeof *k->values);
     }
     /* pass 2: move the columns, last first */
-    for (int32_t j = order - 1; j >= 0;) {
-        int32_t jo = old_column(j, n_free_old, n_fixed_old, nf);
-        size_t pb = pair_start[j], pe = pair_start[j + 1];
-        if (pb == pe) { /* a run of unchanged columns: j2 .. j, old columns consecutive */
+    for (int32_t j = nf - 1; j >= first;) {
+        size_t pb = pair_start[j - first], pe = pair_start[j - first + 1];
+        if (pb == pe) { /* a run of old columns without new pairs: j2 .. j */
             int32_t j2 = j;
-            while (j2 > 0 && pair_start[j2 - 1] == pair_start[j2] && old_column(j2 - 1, n_free_old, n_fixed_old, nf) >= 0)
+            while (j2 > first && pair_start[j2 - 1 - first] == pair_start[j2 - first])
                 j2--;
-            int32_t jo2 = old_column(j2, n_free_old, n_fixed_old, nf);
-            size_t len = (size_t)(k->col_ptr[jo + 1] - k->col_ptr[jo2]);
-            memmove(k->row_idx + ptr[j2], k->row_idx + k->col_ptr[jo2], len * sizeof *k->row_idx);
-            memmove(k->values + ptr[j2], k->values + k->col_ptr[jo2], len * sizeof *k->values);
-            if (j2 >= nf && shift > 0) /* fixed columns: their diagonals (the last entries) move up */
-                for (int32_t c = j2; c <= j; c++)
-                    if (ptr[c + 1] > ptr[c] && k->row_idx[ptr[c + 1] - 1] >= n_free_old)
-                        k->row_idx[ptr[c + 1] - 1] = (int32_t)new_row(k->row_idx[ptr[c + 1] - 1], n_free_old, shift);
+            size_t len = (size_t)(k->col_ptr[j + 1] - k->col_ptr[j2]);
+            if (ptr[j2 - first] != k->col_ptr[j2]) {
+                memmove(k->row_idx + ptr[j2 - first], k->row_idx + k->col_ptr[j2], len * sizeof *k->row_idx);
+                memmove(k->values + ptr[j2 - first], k->values + k->col_ptr[j2], len * sizeof *k->values);
+            }
             j = j2 - 1;
             continue;
         }
-        int64_t o = jo >= 0 ? k->col_ptr[jo + 1] - 1 : -1, o_begin = jo >= 0 ? k->col_ptr[jo] : 0;
-        int64_t q = (int64_t)pe - 1, d = ptr[j + 1] - 1;
+        int64_t o = j < n_free_old ? k->col_ptr[j + 1] - 1 : -1, o_begin = j < n_free_old ? k->col_ptr[j] : 0;
+        int64_t q = (int64_t)pe - 1, d = ptr[j - first + 1] - 1;
         while (o >= o_begin || q >= (int64_t)pb) {
-            int64_t r_old = o >= o_begin ? new_row(k->row_idx[o], n_free_old, shift) : -1;
-            int64_t r_new = q >= (int64_t)pb ? pairs[q] % order : -1;
+            int64_t r_old = o >= o_begin ? k->row_idx[o] : -1;
+            int64_t r_new = q >= (int64_t)pb ? pairs[q] % nf : -1;
             int64_t r = r_old > r_new ? r_old : r_new;
             double v = r_old == r ? k->values[o--] : 0.0;
-            while (q >= (int64_t)pb && pairs[q] % order == r)
+            while (q >= (int64_t)pb && pairs[q] % nf == r)
                 q--;
             k->row_idx[d] = (int32_t)r;
             k->values[d--] = v;
         }
-        FS_ASSERT(d + 1 == ptr[j]);
+        FS_ASSERT(d + 1 == ptr[j - first]);
         j--;
     }
+    k->col_ptr = fs_realloc(k->col_ptr, ((size_t)nf + 1) * sizeof *k->col_ptr);
+    memcpy(k->col_ptr + first, ptr, ((size_t)span + 1) * sizeof *ptr);
+    k->n = nf;
     free(pairs);
+    free(ptr);
     free(pair_start);
-    free(k->col_ptr);
-    k->col_ptr = ptr;
-    k->n = order;
-    set_view(w);
 
+vectors:;
     double *load = fs_calloc((size_t)FS_WEDGE_PATTERNS * (nf ? nf : 1), sizeof *load);
     for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
         memcpy(load + (size_t)q * nf, w->load + (size_t)q * n_free_old, (size_t)n_free_old * sizeof *load);
     free(w->load);
     w->load = load;
     w->rhs = fs_realloc(w->rhs, ((size_t)nf + 1) * sizeof *w->rhs);
-    w->x = fs_realloc(w->x, ((size_t)nf + 1) * sizeof *w->x);
-    for (int32_t i = n_free_old; i < nf; i++)
-        w->x[i] = 0.0;
+    w->x = grow_zeroed(w->x, (size_t)n_free_old, (size_t)nf + 1, sizeof *w->x);
     w->u_fixed = fs_realloc(w->u_fixed, ((size_t)w->n_fixed + 1) * sizeof *w->u_fixed);
-    free(w->mark);
-    w->mark = fs_calloc((size_t)order + 1, sizeof *w->mark);
+    w->mark = grow_zeroed(w->mark, (size_t)n_free_old + (size_t)n_fixed_old + 1, (size_t)nf + w->n_fixed + 1,
+                          sizeof *w->mark);
     return 0;
 }
 

@@ -91,6 +91,19 @@ typedef struct {
 
 /* The whole state of one layer. Arrays are flat and indexed by mesh node or mesh triangle (one wedge
  * per triangle); the model owns all of them except the mesh. */
+/* The coupling K_fb of the free DOFs with the fixed ones: one column per fixed DOF (its index minus
+ * n_free), holding its free rows strictly ascending with their values. A column lives in
+ * row[start .. start + len) with room up to start + cap, so a cut adds entries in place; a full column
+ * moves to the end of the pool (see coupling_insert in wedge.c). Fixed indices and free rows keep
+ * their numbers when nodes are added (number_dofs), so no column ever shifts. */
+typedef struct {
+    int32_t n;                   /* columns (n_fixed) */
+    int32_t *start, *len, *cap;  /* per column */
+    int32_t *row;                /* free row of each slot */
+    double *value;               /* value of each slot */
+    size_t used, size;           /* slots handed out (holes left by moved columns included), allocated */
+} fs_wedge_coupling;
+
 typedef struct {
     fs_mesh *mesh;               /* borrowed, must outlive the model; subdivision refines it in place */
     fs_config cfg;               /* copy of the configuration the model was built from */
@@ -145,13 +158,12 @@ typedef struct {
     int32_t n_free, n_fixed;
     int32_t *dof;                /* 6 per node: index of each node DOF in that numbering */
     int32_t *fixed_node_dof;     /* n_fixed: the node DOF (6 i + k) of each fixed index */
-    fs_sparse_matrix k_all;      /* upper CSC of order n_free + n_fixed: the free-free block in the
-                                    leading columns, the free-fixed coupling in the others (no
-                                    fixed-fixed entries but each fixed column's own
-                                    zero diagonal) */
-    size_t k_all_capacity;       /* entries k_all's row and value arrays have room for (they grow
-                                    geometrically as the mesh is cut, see extend_system) */
-    fs_sparse_matrix k_free;     /* a view of k_all's leading n_free columns (shares its arrays) */
+    fs_sparse_matrix k_free;     /* upper CSC of order n_free: K_ff (its row and value arrays have
+                                    room for k_free_capacity entries: they grow geometrically as the
+                                    mesh is cut, see extend_system) */
+    size_t k_free_capacity;
+    fs_wedge_coupling k_fb;      /* K_fb: the free rows coupled to each fixed DOF (no fixed-fixed
+                                    entries) */
     double *load;                /* 6 * n_free: unit loads; 0..2 shrinkage (per unit of scale - 1),
                                     3..5 eigenstrain xx, yy, xy (per unit of eigenstrain) */
     double *rhs, *x;             /* n_free each: the right-hand side and the free displacements */
@@ -230,6 +242,10 @@ static inline void fs_wedge_load_coefficients(const fs_wedge_model *w, double co
 
 /* w->rhs = the loads at the current coefficients net of the fixed DOFs' motion, f - K_fb u_b. */
 void fs_wedge_build_rhs(fs_wedge_model *w);
+
+/* The stiffness coupling free DOF g with DOF j (free or fixed) in the assembled system, 0 when the
+ * pattern holds no such entry (binary search: O(log) of a column). */
+double fs_wedge_system_entry(const fs_wedge_model *w, int32_t g, int32_t j);
 
 /* An equilibrium state of the model at one time, on an unchanged mesh: what fs_wedge_interpolate
  * blends. Owns its arrays; release with fs_wedge_snapshot_free. */
@@ -445,7 +461,7 @@ double fs_wedge_tips_unit(fs_wedge_model *w);
  * add up the small residuals every accepted event leaves on the rim of its region, so it does not
  * depend on the number of earlier events or on the size of the mesh.
  *
- * Contract: called at the current time w->time after the change, with k_all and the loads describing
+ * Contract: called at the current time w->time after the change, with k_free, k_fb and the loads describing
  * the changed mesh (w->factor_stale set if the factor no longer matches k_free), w->u holding a
  * starting guess for every free DOF (fixed ones are set from their prescribed motion, see
  * fs_wedge_prescribe_fixed), w->x, w->u_fixed and w->rhs sized for the current numbering, node_elem

@@ -491,26 +491,14 @@ static double row_residual(const fs_wedge_model *w, int32_t g, int32_t node, ili
             }
         }
     }
-    const fs_sparse_matrix *k = &w->k_all;
     for (int32_t q = 0; q < nb->n; q++) {
         int32_t b = nb->v[q];
         flag[b] = 0;
         for (int l = 0; l < 6; l++) {
             int32_t j = w->dof[6 * (size_t)b + l];
             double v = j < nf ? w->x[j] : w->u_fixed[j - nf];
-            if (v == 0.0)
-                continue;
-            int32_t col = j > g ? j : g, row = j > g ? g : j;
-            int32_t lo = k->col_ptr[col], hi = k->col_ptr[col + 1];
-            while (lo < hi) { /* rows ascending within a column */
-                int32_t mid = lo + (hi - lo) / 2;
-                if (k->row_idx[mid] < row)
-                    lo = mid + 1;
-                else
-                    hi = mid;
-            }
-            if (lo < k->col_ptr[col + 1] && k->row_idx[lo] == row)
-                s -= k->values[lo] * v;
+            if (v != 0.0)
+                s -= fs_wedge_system_entry(w, g, j) * v;
         }
     }
     return s;
