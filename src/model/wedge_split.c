@@ -389,15 +389,38 @@ static void set_corner(fs_mesh *m, int32_t t, int c, int32_t i, const double p[3
     m->shift[6 * (size_t)t + 2 * c + 1] = (int8_t)lround((p[1] - q[1]) / ey);
 }
 
-/* Living triangles that have node i as a corner, ascending (a scan: the cut changes the mesh under
- * every incremental structure). */
-static void tris_at(const fs_wedge_model *w, int32_t i, ilist *out)
+static int cmp_int32(const void *a, const void *b)
 {
-    out->n = 0;
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Living triangles that have node i as a corner, ascending, in the mesh as the cut has changed it so
+ * far: those the model's node_elem lists for i (the mesh before the cut), the changed ones and the
+ * new ones, kept where i is still or now a corner (every corner the cut rewrites is in a changed or
+ * new triangle). */
+static void tris_at(const cut_state *cs, int32_t i, ilist *out)
+{
+    const fs_wedge_model *w = cs->w;
     const fs_mesh *m = w->mesh;
-    for (int32_t t = 0; t < m->n_tris; t++)
-        if ((t >= w->n_elems || w->state[t] == FS_WEDGE_ALIVE) && fs_mesh_corner_of(m, t, i) >= 0)
-            ilist_push(out, t);
+    out->n = 0;
+    if (i < w->n_nodes)
+        for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++)
+            ilist_push(out, w->node_elem[p]);
+    for (int32_t q = 0; q < cs->changed_list.n; q++)
+        ilist_push(out, cs->changed_list.v[q]);
+    for (int32_t t = cs->n_tris0; t < m->n_tris; t++)
+        ilist_push(out, t);
+    qsort(out->v, (size_t)out->n, sizeof *out->v, cmp_int32);
+    int32_t kept = 0;
+    for (int32_t q = 0; q < out->n; q++) {
+        int32_t t = out->v[q];
+        if ((kept > 0 && out->v[kept - 1] == t) || !(t >= w->n_elems || w->state[t] == FS_WEDGE_ALIVE) ||
+            fs_mesh_corner_of(m, t, i) < 0)
+            continue;
+        out->v[kept++] = t;
+    }
+    out->n = kept;
 }
 
 /* Corner c of triangle t relative to corner cn, in the 2-D frame. */
@@ -480,7 +503,7 @@ static bool collapse(cut_state *cs, const fs_wedge_frame *f, int32_t v, const do
     if (w->flat && (wrapped[0] != moved[0] || wrapped[1] != moved[1]))
         return false;
     ilist ring = {0};
-    tris_at(w, v, &ring);
+    tris_at(cs, v, &ring);
     double *before = fs_malloc(((size_t)ring.n + 1) * sizeof *before);
     for (int32_t q = 0; q < ring.n; q++)
         before[q] = area_2d(m, f, ring.v[q]);
@@ -505,7 +528,7 @@ static int32_t cast_ray(cut_state *cs, const fs_wedge_frame *f, int32_t n, const
     fs_wedge_model *w = cs->w;
     fs_mesh *m = w->mesh;
     ilist fan = {0};
-    tris_at(w, n, &fan);
+    tris_at(cs, n, &fan);
     int32_t far = -1;
     for (int32_t q = 0; q < fan.n && far < 0; q++) {
         int32_t t = fan.v[q];
@@ -549,7 +572,7 @@ static int32_t duplicate_node(cut_state *cs, int32_t v, const int32_t *cut, int3
     fs_wedge_model *w = cs->w;
     fs_mesh *m = w->mesh;
     ilist fan = {0};
-    tris_at(w, v, &fan);
+    tris_at(cs, v, &fan);
     int32_t *parent = fs_malloc(((size_t)fan.n + 1) * sizeof *parent);
     for (int32_t q = 0; q < fan.n; q++)
         parent[q] = q;
