@@ -1,6 +1,7 @@
 /* Jacobi-preconditioned conjugate gradients on an upper-triangle CSC matrix: the baseline beside CHOLMOD. */
 #include "solve/cg.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdbool.h>
 
@@ -16,24 +17,46 @@ fs_cg_params fs_cg_params_default(void)
     return params;
 }
 
+/* u . v summed in four interleaved partial sums (a fixed order, so deterministic): the additions of
+ * one running sum would wait on each other. */
 static double dot(int32_t n, const double *u, const double *v)
 {
-    double s = 0.0;
-    for (int32_t i = 0; i < n; i++)
-        s += u[i] * v[i];
-    return s;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    int32_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        s0 += u[i] * v[i];
+        s1 += u[i + 1] * v[i + 1];
+        s2 += u[i + 2] * v[i + 2];
+        s3 += u[i + 3] * v[i + 3];
+    }
+    for (; i < n; i++)
+        s0 += u[i] * v[i];
+    return (s0 + s1) + (s2 + s3);
 }
 
-/* The largest |v[i]|, or NaN if an entry is NaN (so a NaN residual never passes a bound). */
+/* The largest |v[i]|, or NaN if an entry is not finite (so such a residual never passes a bound),
+ * in four interleaved running maxima. */
 static double max_abs(int32_t n, const double *v)
 {
-    double m = 0.0;
-    for (int32_t i = 0; i < n; i++) {
-        double a = fabs(v[i]);
-        if (!(a <= m))
-            m = a;
+    double m0 = 0.0, m1 = 0.0, m2 = 0.0, m3 = 0.0;
+    bool bad = false;
+    int32_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        double a0 = fabs(v[i]), a1 = fabs(v[i + 1]), a2 = fabs(v[i + 2]), a3 = fabs(v[i + 3]);
+        m0 = a0 > m0 ? a0 : m0;
+        m1 = a1 > m1 ? a1 : m1;
+        m2 = a2 > m2 ? a2 : m2;
+        m3 = a3 > m3 ? a3 : m3;
+        bad |= !(a0 <= DBL_MAX) | !(a1 <= DBL_MAX) | !(a2 <= DBL_MAX) | !(a3 <= DBL_MAX);
     }
-    return m;
+    for (; i < n; i++) {
+        double a = fabs(v[i]);
+        m0 = a > m0 ? a : m0;
+        bad |= !(a <= DBL_MAX);
+    }
+    m0 = m1 > m0 ? m1 : m0;
+    m2 = m3 > m2 ? m3 : m2;
+    return bad ? NAN : m2 > m0 ? m2 : m0;
 }
 
 /* The stopping rule: with a max_residual, every entry of r within it, else the Euclidean norm rnorm
