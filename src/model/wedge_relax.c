@@ -89,11 +89,15 @@ static double residual(fs_wedge_model *w, double *r)
     return sqrt(b2);
 }
 
+/* The largest |v[i]| (NaN entries are passed over, as fmax does). */
 static double norm_max(const double *v, int32_t n)
 {
     double s = 0.0;
-    for (int32_t i = 0; i < n; i++)
-        s = fmax(s, fabs(v[i]));
+    for (int32_t i = 0; i < n; i++) {
+        double a = fabs(v[i]);
+        if (a > s)
+            s = a;
+    }
     return s;
 }
 
@@ -232,8 +236,6 @@ static int32_t sort_unique(int32_t *v, int32_t n, int32_t range)
 static int local_solve(fs_wedge_model *w, const int32_t *idx, int32_t m, int32_t *map, const double *r,
                        double *delta, double tol)
 {
-    fs_sparse_matrix sub = {0};
-    fs_sparse_matrix_principal(&w->k_free, idx, m, map, &sub);
     double *b = fs_malloc((size_t)m * sizeof *b);
     for (int32_t q = 0; q < m; q++) {
         b[q] = r[idx[q]];
@@ -242,18 +244,20 @@ static int local_solve(fs_wedge_model *w, const int32_t *idx, int32_t m, int32_t
     fs_cg_params p = fs_cg_params_default();
     p.max_residual = 0.3 * tol;
     p.block = 3; /* a node's three unknowns are consecutive (number_dofs) */
-    int it = fs_cg_solve(&sub, b, delta, p, NULL), rc = it < 0 ? -1 : 0;
+    int it = fs_cg_solve_principal(&w->k_free, idx, m, map, b, delta, p, NULL), rc = it < 0 ? -1 : 0;
     if (it > 0)
         w->counters.local_cg_iterations += it;
     if (rc < 0) {
         fs_error_clear();
+        fs_sparse_matrix sub = {0};
+        fs_sparse_matrix_principal(&w->k_free, idx, m, map, &sub);
         fs_cholesky *c = fs_cholesky_analyze(&sub);
         rc = c ? fs_cholesky_factorize(c, &sub) : -1;
         if (rc == 0)
             rc = fs_cholesky_solve(c, 1, b, delta);
         fs_cholesky_free(c);
+        fs_sparse_matrix_free(&sub);
     }
-    fs_sparse_matrix_free(&sub);
     free(b);
     return rc;
 }

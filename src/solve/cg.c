@@ -153,6 +153,114 @@ static void block3_build(const fs_sparse_matrix *a, block3_matrix *b)
     free(slot_t);
 }
 
+/* design: the elasticity systems come in whole 3x3 blocks: a node's three unknowns are consecutive
+ * from a multiple of 3, and the three columns of a node list the same coupled nodes (all nine entries
+ * of each block off the diagonal, the upper six of the diagonal block). Such a matrix, or its
+ * principal submatrix on whole nodes, is copied into blocks straight from its columns, a triple of
+ * rows at a time; anything else goes through the general copy (block3_build). */
+
+/* Whether block column g (unknowns 3g .. 3g + 2) of a has the layout above; *k receives its number
+ * of coupled nodes above the diagonal. */
+static bool block_column_regular(const fs_sparse_matrix *a, int32_t g, int32_t *k)
+{
+    const int32_t *cp = a->col_ptr + 3 * (size_t)g, *ri = a->row_idx;
+    int32_t len0 = cp[1] - cp[0], len1 = cp[2] - cp[1], len2 = cp[3] - cp[2];
+    if (len2 < 3 || len2 % 3 != 0 || len1 != len2 - 1 || len0 != len2 - 2)
+        return false;
+    int32_t kk = len2 / 3 - 1, c = 3 * g;
+    for (int32_t q = 0; q < kk; q++) {
+        int32_t t = ri[cp[2] + 3 * q];
+        if (t % 3 != 0 || t >= c)
+            return false;
+        for (int l = 0; l < 3; l++)
+            for (int r = 0; r < 3; r++)
+                if (ri[cp[l] + 3 * q + r] != t + r)
+                    return false;
+    }
+    if (ri[cp[1] - 1] != c || ri[cp[2] - 2] != c || ri[cp[2] - 1] != c + 1 || ri[cp[3] - 3] != c ||
+        ri[cp[3] - 2] != c + 1 || ri[cp[3] - 1] != c + 2)
+        return false;
+    *k = kk;
+    return true;
+}
+
+/* The blocks of the principal submatrix of a on the whole nodes idx (m unknowns; NULL: all of a, m =
+ * a->n), map as in fs_sparse_matrix_principal (unused without idx). Returns false, b untouched, if a
+ * does not have the layout of the design note there or idx does not list whole nodes. */
+static bool block3_build_regular(const fs_sparse_matrix *a, const int32_t *idx, int32_t m, int32_t *map,
+                                 block3_matrix *b)
+{
+    int32_t nb = m / 3;
+    int32_t *kk = fs_malloc(((size_t)nb + 1) * sizeof *kk), *next = fs_calloc((size_t)nb + 1, sizeof *next);
+    bool ok = m % 3 == 0;
+    for (int32_t jb = 0; jb < nb && ok; jb++) {
+        int32_t c = idx ? idx[3 * jb] : 3 * jb;
+        ok = c % 3 == 0 && (!idx || (idx[3 * jb + 1] == c + 1 && idx[3 * jb + 2] == c + 2)) &&
+             block_column_regular(a, c / 3, &kk[jb]);
+    }
+    if (idx)
+        for (int32_t q = 0; q < m && ok; q++)
+            map[idx[q]] = q;
+    /* pass 1: blocks per block row */
+    for (int32_t jb = 0; jb < nb && ok; jb++) {
+        const int32_t *rows = a->row_idx + a->col_ptr[(idx ? idx[3 * jb] : 3 * jb) + 2];
+        for (int32_t q = 0; q < kk[jb]; q++) {
+            int32_t i = idx ? map[rows[3 * q]] : rows[3 * q];
+            if (i < 0)
+                continue;
+            next[i / 3]++;
+            next[jb]++;
+        }
+        next[jb]++;
+    }
+    if (ok) {
+        b->nb = nb;
+        b->row_ptr = fs_malloc(((size_t)nb + 1) * sizeof *b->row_ptr);
+        int32_t total = 0;
+        for (int32_t i = 0; i < nb; i++) {
+            b->row_ptr[i] = total;
+            total += next[i];
+            next[i] = b->row_ptr[i];
+        }
+        b->row_ptr[nb] = total;
+        b->col = fs_malloc(((size_t)total + 1) * sizeof *b->col);
+        b->v = fs_malloc(9 * ((size_t)total + 1) * sizeof *b->v);
+        b->diag = fs_malloc(((size_t)nb + 1) * sizeof *b->diag);
+    }
+    /* pass 2: the blocks, a triple of rows of the node's three columns at a time */
+    for (int32_t jb = 0; jb < nb && ok; jb++) {
+        int32_t c = idx ? idx[3 * jb] : 3 * jb;
+        const int32_t *p = a->col_ptr + c;
+        for (int32_t q = 0; q <= kk[jb]; q++) {
+            int32_t ib = q < kk[jb] ? (idx ? map[a->row_idx[p[2] + 3 * q]] : a->row_idx[p[2] + 3 * q]) : 3 * jb;
+            if (ib < 0)
+                continue;
+            ib /= 3;
+            int32_t up = next[ib]++, lo = ib != jb ? next[jb]++ : up;
+            b->col[up] = jb;
+            b->col[lo] = ib;
+            double *u = b->v + 9 * (size_t)up, *t = b->v + 9 * (size_t)lo;
+            for (int l = 0; l < 3; l++)
+                for (int r = 0; r < 3; r++) {
+                    /* entry (row 3 ib + r, column 3 jb + l); the diagonal block holds r <= l only */
+                    if (ib == jb && r > l)
+                        continue;
+                    double v = a->values[p[l] + 3 * q + r];
+                    u[3 * r + l] = v;
+                    t[3 * l + r] = v;
+                }
+            if (ib == jb)
+                b->diag[jb] = up;
+        }
+    }
+    if (idx)
+        for (int32_t q = 0; q < m; q++)
+            map[idx[q]] = -1;
+    free(kk);
+    free(next);
+    return ok;
+}
+
 static void block3_matvec(const block3_matrix *b, const double *x, double *y)
 {
     for (int32_t ib = 0; ib < b->nb; ib++) {
@@ -214,8 +322,8 @@ static double precondition(int32_t n, int32_t block, const double *inv, const do
  * block is not positive definite. */
 static int preconditioner(const fs_sparse_matrix *a, const block3_matrix *blocks, double *inv)
 {
-    int32_t n = a->n;
     if (!blocks) {
+        int32_t n = a->n;
         for (int32_t j = 0; j < n; j++) {
             double d = 0.0;
             for (int32_t k = a->col_ptr[j + 1] - 1; k >= a->col_ptr[j]; k--) {
@@ -254,10 +362,10 @@ static int preconditioner(const fs_sparse_matrix *a, const block3_matrix *blocks
 /* design: textbook preconditioned CG (Hestenes–Stiefel recurrences). The recurrence residual drifts from
  * the true one in floating point, so convergence is only accepted after recomputing b - A x; if that
  * fails, the search restarts from the true residual. */
-int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_params params,
-                double *relative_residual)
+/* The iteration of fs_cg_solve on n unknowns with the matrix op (with blocks: params.block = 3). */
+static int cg_run(const operator_t *op, int32_t n, const double *b, double *x, fs_cg_params params,
+                  double *relative_residual)
 {
-    int32_t n = a->n;
     int32_t max_iterations = params.max_iterations > 0 ? params.max_iterations : n;
     double bnorm = sqrt(dot(n, b, b));
     if (relative_residual)
@@ -268,14 +376,7 @@ int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_par
         return 0;
     }
 
-    int32_t block = params.block == 3 ? 3 : 1;
-    FS_ASSERT(n % block == 0);
-    block3_matrix blocks = {0};
-    operator_t op = {a, NULL};
-    if (block == 3) {
-        block3_build(a, &blocks);
-        op.b = &blocks;
-    }
+    int32_t block = op->b ? 3 : 1;
     double *scratch = fs_malloc((3 + (size_t)block) * (size_t)n * sizeof *scratch);
     double *r = scratch;
     double *z = scratch + n;
@@ -283,20 +384,20 @@ int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_par
     double *inv = scratch + 3 * (size_t)n;
     double *q = z; /* A p and the residual scratch share z's storage: each is dead before z is rewritten */
     int status = -1;
-    if (preconditioner(a, op.b, inv) < 0)
+    if (preconditioner(op->a, op->b, inv) < 0)
         goto done;
 
     /* with the max_residual rule the Euclidean norm is only needed for the report */
     bool by_max = params.max_residual > 0.0;
     double limit = params.tolerance * bnorm;
-    double rnorm = true_residual(&op, n, b, x, r, q);
+    double rnorm = true_residual(op, n, b, x, r, q);
     int32_t iterations = 0;
     if (!converged(&params, n, r, rnorm, limit)) {
         double rz = precondition(n, block, inv, r, z);
         for (int32_t i = 0; i < n; i++)
             p[i] = z[i];
         while (iterations < max_iterations) {
-            apply(&op, p, q);
+            apply(op, p, q);
             double curvature = dot(n, p, q);
             if (!(curvature > 0.0)) {
                 fs_error(FS_ERR_INTERNAL, "cg: matrix not positive definite (p'Ap = %g at iteration %d)",
@@ -311,7 +412,7 @@ int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_par
             iterations++;
             rnorm = by_max ? NAN : sqrt(dot(n, r, r));
             if (converged(&params, n, r, rnorm, limit)) {
-                rnorm = true_residual(&op, n, b, x, r, q);
+                rnorm = true_residual(op, n, b, x, r, q);
                 if (converged(&params, n, r, rnorm, limit))
                     break;
                 rz = precondition(n, block, inv, r, z);
@@ -338,6 +439,38 @@ int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_par
     status = iterations;
 done:
     free(scratch);
+    return status;
+}
+
+int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_params params,
+                double *relative_residual)
+{
+    FS_ASSERT(params.block != 3 || a->n % 3 == 0);
+    block3_matrix blocks = {0};
+    operator_t op = {a, NULL};
+    if (params.block == 3) {
+        if (!block3_build_regular(a, NULL, a->n, NULL, &blocks))
+            block3_build(a, &blocks);
+        op.b = &blocks;
+    }
+    int status = cg_run(&op, a->n, b, x, params, relative_residual);
     block3_free(&blocks);
+    return status;
+}
+
+int fs_cg_solve_principal(const fs_sparse_matrix *a, const int32_t *idx, int32_t m, int32_t *map, const double *b,
+                          double *x, fs_cg_params params, double *relative_residual)
+{
+    block3_matrix blocks = {0};
+    if (params.block == 3 && block3_build_regular(a, idx, m, map, &blocks)) {
+        operator_t op = {NULL, &blocks};
+        int status = cg_run(&op, m, b, x, params, relative_residual);
+        block3_free(&blocks);
+        return status;
+    }
+    fs_sparse_matrix sub = {0};
+    fs_sparse_matrix_principal(a, idx, m, map, &sub);
+    int status = fs_cg_solve(&sub, b, x, params, relative_residual);
+    fs_sparse_matrix_free(&sub);
     return status;
 }

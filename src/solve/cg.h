@@ -32,4 +32,13 @@ fs_cg_params fs_cg_params_default(void);
 int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_params params,
                 double *relative_residual);
 
+/* fs_cg_solve on the principal submatrix of a on the unknowns idx (m of them, strictly increasing;
+ * b and x have m elements, x[q] the unknown idx[q]). map is scratch as in fs_sparse_matrix_principal
+ * (a->n entries, all -1 on entry and on return). With params.block = 3, idx listing whole nodes (idx[3k]
+ * a multiple of 3, then the next two) and a made of whole 3x3 blocks (elasticity: each node's three
+ * columns list the same coupled nodes), the solver's blocks are copied straight from a, without the
+ * submatrix; the result is the same bit for bit. */
+int fs_cg_solve_principal(const fs_sparse_matrix *a, const int32_t *idx, int32_t m, int32_t *map, const double *b,
+                          double *x, fs_cg_params params, double *relative_residual);
+
 #endif
