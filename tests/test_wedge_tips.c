@@ -174,7 +174,7 @@ static double max_residual(const fs_wedge_model *w, double *tau)
         }
     for (int32_t i = 0; i < nf; i++)
         for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
-            f[i] += coef[q] * w->load[(size_t)q * nf + i];
+            f[i] += coef[q] * w->load[FS_WEDGE_PATTERNS * (size_t)i + q];
     const fs_sparse_matrix *k = &w->k_free;
     for (int32_t j = 0; j < nf; j++)
         for (int32_t p = k->col_ptr[j]; p < k->col_ptr[j + 1]; p++) {

@@ -497,7 +497,7 @@ static void add_loads(fs_wedge_model *w, int32_t e, const double loads[FS_WEDGE_
         if (g >= w->n_free || (only && !only[g]))
             continue;
         for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
-            w->load[(size_t)q * w->n_free + g] += loads[q][a];
+            w->load[FS_WEDGE_PATTERNS * (size_t)g + q] += loads[q][a];
     }
 }
 
@@ -560,6 +560,7 @@ static int build_system(fs_wedge_model *w)
     fs_sparse_builder_init(&b, order, (size_t)alive * 171);
     free(w->load);
     w->load = fs_calloc((size_t)FS_WEDGE_PATTERNS * (w->n_free ? w->n_free : 1), sizeof *w->load);
+    w->load_capacity = w->n_free;
     double K[324], loads[FS_WEDGE_PATTERNS][18];
     for (int32_t e = 0; e < w->n_elems; e++) {
         if (w->state[e] != FS_WEDGE_ALIVE)
@@ -687,7 +688,7 @@ void fs_wedge_build_rhs(fs_wedge_model *w)
     for (int32_t i = 0; i < nf; i++) {
         double s = 0.0;
         for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
-            s += coef[q] * w->load[(size_t)q * nf + i];
+            s += coef[q] * w->load[FS_WEDGE_PATTERNS * (size_t)i + q];
         w->rhs[i] = s;
     }
     const fs_wedge_coupling *c = &w->k_fb;
@@ -1383,7 +1384,7 @@ static int update_region(fs_wedge_model *w, const int32_t *nodes, int32_t n)
             if (w->mark[k->row_idx[p]])
                 k->values[p] = 0.0;
         for (int pat = 0; pat < FS_WEDGE_PATTERNS; pat++)
-            w->load[(size_t)pat * w->n_free + j] = 0.0;
+            w->load[FS_WEDGE_PATTERNS * (size_t)j + pat] = 0.0;
     }
     int32_t cap = 0, ne = 0;
     for (int32_t q = 0; q < n; q++)
@@ -1694,11 +1695,12 @@ static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_
     free(pair_start);
 
 vectors:;
-    double *load = fs_calloc((size_t)FS_WEDGE_PATTERNS * (nf ? nf : 1), sizeof *load);
-    for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
-        memcpy(load + (size_t)q * nf, w->load + (size_t)q * n_free_old, (size_t)n_free_old * sizeof *load);
-    free(w->load);
-    w->load = load;
+    if (nf > w->load_capacity) {
+        w->load_capacity = nf + nf / 2;
+        w->load = fs_realloc(w->load, (size_t)FS_WEDGE_PATTERNS * w->load_capacity * sizeof *w->load);
+    }
+    memset(w->load + FS_WEDGE_PATTERNS * (size_t)n_free_old, 0,
+           FS_WEDGE_PATTERNS * (size_t)(nf - n_free_old) * sizeof *w->load);
     w->rhs = fs_realloc(w->rhs, ((size_t)nf + 1) * sizeof *w->rhs);
     w->x = grow_zeroed(w->x, (size_t)n_free_old, (size_t)nf + 1, sizeof *w->x);
     w->u_fixed = fs_realloc(w->u_fixed, ((size_t)w->n_fixed + 1) * sizeof *w->u_fixed);

@@ -164,8 +164,10 @@ typedef struct {
     size_t k_free_capacity;
     fs_wedge_coupling k_fb;      /* K_fb: the free rows coupled to each fixed DOF (no fixed-fixed
                                     entries) */
-    double *load;                /* 6 * n_free: unit loads; 0..2 shrinkage (per unit of scale - 1),
-                                    3..5 eigenstrain xx, yy, xy (per unit of eigenstrain) */
+    double *load;                /* 6 per free DOF (load[6 g + q]): unit loads; q = 0..2 shrinkage
+                                    (per unit of scale - 1), 3..5 eigenstrain xx, yy, xy (per unit
+                                    of eigenstrain) */
+    int32_t load_capacity;       /* free DOFs load has room for (it grows geometrically) */
     double *rhs, *x;             /* n_free each: the right-hand side and the free displacements */
     double *u_fixed;             /* n_fixed: displacement of the fixed DOFs */
     uint8_t *mark;               /* n_free + n_fixed scratch flags, all 0 between calls */

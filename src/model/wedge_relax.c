@@ -481,7 +481,7 @@ static double row_residual(const fs_wedge_model *w, int32_t g, int32_t node, ili
     fs_wedge_load_coefficients(w, coef);
     double s = 0.0;
     for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
-        s += coef[q] * w->load[(size_t)q * nf + g];
+        s += coef[q] * w->load[FS_WEDGE_PATTERNS * (size_t)g + q];
     nb->n = 0;
     for (int32_t p = w->node_elem_start[node]; p < w->node_elem_start[node] + w->node_elem_count[node]; p++) {
         int32_t e = w->node_elem[p];
