@@ -860,6 +860,13 @@ static int refresh_cache(fs_wedge_model *w, const int32_t *elems, int32_t n)
         }
         w->ratio_lipschitz[e] = ratio_lipschitz(w, e, c);
         w->ratio_ref_bound[e] = NAN;
+        for (int k = 0; k < 3; k++) {
+            double a[3], b[3], d[3];
+            fs_mesh_corner(w->mesh, e, k, a);
+            fs_mesh_corner(w->mesh, e, (k + 1) % 3, b);
+            fs_sub3(d, a, b);
+            w->edge_rest[3 * (size_t)e + k] = fs_norm3(d);
+        }
     }
     return 0;
 }
@@ -1207,6 +1214,7 @@ static void grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
     w->ratio = fs_realloc(w->ratio, ne * sizeof *w->ratio);
     w->stress_top = fs_realloc(w->stress_top, 18 * ne * sizeof *w->stress_top);
     w->gauss_cache = fs_realloc(w->gauss_cache, GAUSS_CACHE * ne * sizeof *w->gauss_cache);
+    w->edge_rest = fs_realloc(w->edge_rest, 3 * ne * sizeof *w->edge_rest);
     w->node_ratio = fs_realloc(w->node_ratio, nn * sizeof *w->node_ratio);
     for (size_t i = (size_t)w->n_nodes; i < nn; i++)
         w->node_ratio[i] = NAN;
@@ -1315,6 +1323,7 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->residual);
     free(w->dirty_nodes);
     free(w->gauss_cache);
+    free(w->edge_rest);
     free(w->ratio_lipschitz);
     free(w->ratio_ref_bound);
     free(w->ratio_ref_u);

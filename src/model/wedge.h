@@ -140,6 +140,8 @@ typedef struct {
     double *stress_top;          /* 18 per element: Voigt stress (MPa) at the top Gauss points 0..2;
                                     with lazy_ratios, as of the element's last full evaluation */
     double *gauss_cache;         /* 108 per element: geometry terms of the stress check (wedge.c) */
+    double *edge_rest;           /* 3 per living element: length (cm) of its edge c (corners c and
+                                    c + 1) in the surface mesh at rest, set with gauss_cache */
     bool lazy_ratios;            /* re-evaluate at the same time only the elements whose ratio bound
                                     could have reached 1 (wedge.c, element_ratios); set by
                                     fs_wedge_run for element removal, off by default */

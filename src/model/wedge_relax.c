@@ -5,7 +5,6 @@
 
 #include "base/error.h"
 #include "base/log.h"
-#include "base/vec.h"
 #include "model/wedge.h"
 #include "solve/cg.h"
 #include "solve/sparse.h"
@@ -103,14 +102,10 @@ static double norm_max(const double *v, int32_t n)
 
 /* ---- marking ---- */
 
-/* Length of the edge from corner a to corner b of element e in the surface mesh at rest (cm). */
-static double edge_length(const fs_mesh *m, int32_t e, int a, int b)
+/* Length of the edge between corners a and b of living element e in the surface mesh at rest (cm). */
+static double edge_length(const fs_wedge_model *w, int32_t e, int a, int b)
 {
-    double p[3], q[3], d[3];
-    fs_mesh_corner(m, e, a, p);
-    fs_mesh_corner(m, e, b, q);
-    fs_sub3(d, p, q);
-    return fs_norm3(d);
+    return w->edge_rest[3 * (size_t)e + ((a + 1) % 3 == b ? a : b)];
 }
 
 double fs_wedge_mean_edge(const fs_wedge_model *w)
@@ -121,7 +116,7 @@ double fs_wedge_mean_edge(const fs_wedge_model *w)
         if (w->state[e] != FS_WEDGE_ALIVE)
             continue;
         for (int c = 0; c < 3; c++)
-            sum += edge_length(w->mesh, e, c, (c + 1) % 3);
+            sum += edge_length(w, e, c, (c + 1) % 3);
         count += 3;
     }
     return count ? sum / (double)count : 1.0;
@@ -158,7 +153,7 @@ static int32_t grow_region(const fs_wedge_model *w, const int32_t *seeds, int32_
                 int32_t j = tri[c];
                 if (j == i)
                     continue;
-                double d = it.d + edge_length(w->mesh, e, ci, c);
+                double d = it.d + edge_length(w, e, ci, c);
                 if (d <= radius && d < dist[j]) {
                     if (dist[j] == INFINITY)
                         out[n_out++] = j;
