@@ -262,6 +262,21 @@ static void check_system_is_fresh(fs_wedge_model *w)
             bad += c->row[p] < 0 || c->row[p] >= w->n_free || (p > c->start[col] && c->row[p - 1] >= c->row[p]);
     }
     CHECK_MSG(bad == 0, "%d malformed columns", (int)bad);
+    /* node_elem, updated in place by the changes: each node's elements, ascending */
+    int32_t wrong = 0;
+    int32_t *count = calloc((size_t)w->n_nodes + 1, sizeof *count);
+    for (int32_t e = 0; e < w->n_elems; e++)
+        for (int k = 0; k < 3; k++) {
+            int32_t i = w->mesh->tri[3 * (size_t)e + k], p = w->node_elem_start[i];
+            if ((k > 0 && w->mesh->tri[3 * (size_t)e + k - 1] == i) || (k == 2 && w->mesh->tri[3 * (size_t)e] == i))
+                continue;
+            wrong += count[i] >= w->node_elem_count[i] || w->node_elem[p + count[i]] != e;
+            count[i]++;
+        }
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        wrong += count[i] != w->node_elem_count[i];
+    free(count);
+    CHECK_MSG(wrong == 0, "%d wrong node_elem entries", (int)wrong);
     fs_sparse_matrix old, fresh;
     whole_system(w, &old);
     int32_t order = old.n;

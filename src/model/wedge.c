@@ -224,6 +224,9 @@ static void number_dofs(fs_wedge_model *w)
     w->n_fixed = next - w->n_free;
 }
 
+/* Room each node's element list gets beyond its entries, so that cuts update it in place. */
+#define NODE_ELEM_SLACK 3
+
 static void build_node_elems(fs_wedge_model *w)
 {
     int32_t n = w->n_nodes;
@@ -234,10 +237,11 @@ static void build_node_elems(fs_wedge_model *w)
         for (int c = 0; c < 3; c++)
             w->node_elem_start[w->mesh->tri[3 * (size_t)e + c] + 1]++;
     for (int32_t i = 0; i < n; i++)
-        w->node_elem_start[i + 1] += w->node_elem_start[i];
+        w->node_elem_start[i + 1] += w->node_elem_start[i] + NODE_ELEM_SLACK;
     int32_t *fill = fs_malloc(((size_t)n + 1) * sizeof *fill);
     memcpy(fill, w->node_elem_start, ((size_t)n + 1) * sizeof *fill);
-    w->node_elem = fs_malloc(((size_t)w->node_elem_start[n] + 1) * sizeof *w->node_elem);
+    w->node_elem_capacity = w->node_elem_start[n];
+    w->node_elem = fs_malloc(((size_t)w->node_elem_capacity + 1) * sizeof *w->node_elem);
     for (int32_t e = 0; e < w->n_elems; e++)
         for (int c = 0; c < 3; c++) {
             int32_t node = w->mesh->tri[3 * (size_t)e + c];
@@ -249,6 +253,73 @@ static void build_node_elems(fs_wedge_model *w)
     for (int32_t i = 0; i < n; i++)
         w->node_elem_count[i] = fill[i] - w->node_elem_start[i];
     free(fill);
+}
+
+static int cmp_elem(const void *a, const void *b)
+{
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Brings node_elem up to a change that appended nodes from n0 and elements from e0 and rewrote the
+ * corners of the listed elements only, so that the nodes whose lists change are the corners of the
+ * changed and new elements and those that lost an element (given in lost, nl of them): their lists
+ * are recomputed from their old ones and those elements, in place while they fit their room (new
+ * nodes get theirs at the end), else everything is built again. */
+static void update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const int32_t *changed, int32_t n_changed,
+                              const int32_t *lost, int32_t nl)
+{
+    const fs_mesh *m = w->mesh;
+    int32_t n_new_elems = w->n_elems - e0;
+    int32_t *cand = fs_malloc(((size_t)n_changed + n_new_elems + 64) * sizeof *cand);
+    int32_t cap_cand = n_changed + n_new_elems + 64;
+    /* the start of every new node: after the last list, with room */
+    w->node_elem_start = fs_realloc(w->node_elem_start, ((size_t)w->n_nodes + 1) * sizeof *w->node_elem_start);
+    for (int32_t i = n0; i < w->n_nodes; i++) {
+        w->node_elem_start[i + 1] = w->node_elem_start[i] + NODE_ELEM_SLACK;
+        w->node_elem_count[i] = 0;
+    }
+    int32_t total = w->node_elem_start[w->n_nodes];
+    if (total > w->node_elem_capacity) {
+        w->node_elem_capacity = total + total / 2;
+        w->node_elem = fs_realloc(w->node_elem, ((size_t)w->node_elem_capacity + 1) * sizeof *w->node_elem);
+    }
+    bool fits = true;
+    int32_t n_touch = 3 * (n_changed + n_new_elems) + nl;
+    for (int32_t t = 0; t < n_touch && fits; t++) {
+        int32_t i;
+        if (t < 3 * n_changed)
+            i = m->tri[3 * (size_t)changed[t / 3] + t % 3];
+        else if (t < 3 * (n_changed + n_new_elems))
+            i = m->tri[3 * (size_t)(e0 + (t - 3 * n_changed) / 3) + t % 3];
+        else
+            i = lost[t - 3 * (n_changed + n_new_elems)];
+        int32_t start = w->node_elem_start[i], count = w->node_elem_count[i], nc = 0;
+        if (count + n_changed + n_new_elems > cap_cand) {
+            cap_cand = count + n_changed + n_new_elems;
+            cand = fs_realloc(cand, (size_t)cap_cand * sizeof *cand);
+        }
+        for (int32_t p = start; p < start + count; p++)
+            cand[nc++] = w->node_elem[p];
+        for (int32_t q = 0; q < n_changed; q++)
+            cand[nc++] = changed[q];
+        for (int32_t e = e0; e < w->n_elems; e++)
+            cand[nc++] = e;
+        qsort(cand, (size_t)nc, sizeof *cand, cmp_elem);
+        int32_t kept = 0;
+        for (int32_t q = 0; q < nc; q++)
+            if ((kept == 0 || cand[kept - 1] != cand[q]) && fs_mesh_corner_of(m, cand[q], i) >= 0)
+                cand[kept++] = cand[q];
+        if (kept > w->node_elem_start[i + 1] - start) {
+            fits = false;
+            break;
+        }
+        memcpy(w->node_elem + start, cand, (size_t)kept * sizeof *cand);
+        w->node_elem_count[i] = kept;
+    }
+    free(cand);
+    if (!fits)
+        build_node_elems(w);
 }
 
 /* Living elements that use node i. */
@@ -1877,7 +1948,7 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
         w->threshold[e] = w->threshold[parent];
     }
     number_dofs(w);
-    build_node_elems(w);
+    update_node_elems(w, n0, e0, c->changed, c->n_changed, c->node_parent, 2 * (w->n_nodes - n0));
     int32_t n_changed = c->n_changed + (w->n_elems - e0);
     int32_t *changed = fs_malloc(((size_t)n_changed + 1) * sizeof *changed);
     memcpy(changed, c->changed, (size_t)c->n_changed * sizeof *changed);

@@ -126,6 +126,7 @@ typedef struct {
     int32_t *node_elem_start;    /* n_nodes + 1: elements using each node (CSR, ascending, dead ones too) */
     int32_t *node_elem_count;    /* per node: entries used in node_elem from node_elem_start[i] */
     int32_t *node_elem;
+    int32_t node_elem_capacity;  /* entries node_elem has room for */
 
     /* Elements. */
     int32_t n_elems;
