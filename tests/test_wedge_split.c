@@ -309,14 +309,20 @@ static void check_system_is_fresh(fs_wedge_model *w)
 
 /* The cuts extend the system in place correctly; with growth that moves the fixed bottom nodes, so
  * the coupling is exercised too. */
-static void test_extended_matrix_is_fresh(void)
+/* The stretched strip of 600 elements, not periodic, as a model on m. */
+static void open_strip(fs_mesh *m, fs_wedge_model *w)
 {
     fs_config cfg = wedge_strip_config();
     cfg.domain.periodic_x = cfg.domain.periodic_y = false;
+    CHECK(wedge_test_mesh(&cfg, 600, m) == 0);
+    CHECK(fs_wedge_init(w, m, &cfg) == 0);
+}
+
+static void test_extended_matrix_is_fresh(void)
+{
     fs_mesh m = {0};
-    CHECK(wedge_test_mesh(&cfg, 600, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    open_strip(&m, &w);
     CHECK(fs_wedge_simulate(&w, 1.0) == 0);
     CHECK_MSG(w.fractures >= 10, "%lld splits", (long long)w.fractures);
     check_system_is_fresh(&w);
@@ -336,12 +342,9 @@ static double orientation(const fs_mesh *m, int32_t a, int32_t b, int32_t c)
  * a fresh assembly. */
 static void test_flip_extends_old_columns(void)
 {
-    fs_config cfg = wedge_strip_config();
-    cfg.domain.periodic_x = cfg.domain.periodic_y = false;
     fs_mesh m = {0};
-    CHECK(wedge_test_mesh(&cfg, 600, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    open_strip(&m, &w);
     CHECK(fs_wedge_equilibrium(&w, 0.5) == 0);
     int flips = 0;
     for (int32_t t = 0; t < m.n_tris && flips < 3; t += 37) {

@@ -88,6 +88,26 @@ static void block3_free(block3_matrix *b)
     free(b->v);
 }
 
+/* Lays out b's nb block rows from their block counts (next[i], turned into each row's first free
+ * slot) and allocates the blocks, zeroed, with no diagonal block found yet. */
+static void block3_alloc(block3_matrix *b, int32_t nb, int32_t *next)
+{
+    b->nb = nb;
+    b->row_ptr = fs_malloc(((size_t)nb + 1) * sizeof *b->row_ptr);
+    int32_t total = 0;
+    for (int32_t i = 0; i < nb; i++) {
+        b->row_ptr[i] = total;
+        total += next[i];
+        next[i] = b->row_ptr[i];
+    }
+    b->row_ptr[nb] = total;
+    b->col = fs_malloc(((size_t)total + 1) * sizeof *b->col);
+    b->v = fs_calloc(9 * ((size_t)total + 1), sizeof *b->v);
+    b->diag = fs_malloc(((size_t)nb + 1) * sizeof *b->diag);
+    for (int32_t i = 0; i < nb; i++)
+        b->diag[i] = -1;
+}
+
 /* Copies the upper-triangle CSC a (a->n a multiple of 3) into b, both triangles; absent entries of a
  * stored block are 0. */
 static void block3_build(const fs_sparse_matrix *a, block3_matrix *b)
@@ -111,21 +131,9 @@ static void block3_build(const fs_sparse_matrix *a, block3_matrix *b)
                 if (ib != jb)
                     next[jb]++;
             }
-    b->nb = nb;
-    b->row_ptr = fs_malloc(((size_t)nb + 1) * sizeof *b->row_ptr);
-    int32_t total = 0;
-    for (int32_t i = 0; i < nb; i++) {
-        b->row_ptr[i] = total;
-        total += next[i];
-        next[i] = b->row_ptr[i];
-        mark[i] = -1;
-    }
-    b->row_ptr[nb] = total;
-    b->col = fs_malloc(((size_t)total + 1) * sizeof *b->col);
-    b->v = fs_calloc(9 * ((size_t)total + 1), sizeof *b->v);
-    b->diag = fs_malloc(((size_t)nb + 1) * sizeof *b->diag);
+    block3_alloc(b, nb, next);
     for (int32_t i = 0; i < nb; i++)
-        b->diag[i] = -1;
+        mark[i] = -1;
     /* pass 2: place the blocks and their values */
     for (int32_t jb = 0; jb < nb; jb++)
         for (int32_t j = 3 * jb; j < 3 * jb + 3; j++)
@@ -213,20 +221,8 @@ static bool block3_build_regular(const fs_sparse_matrix *a, const int32_t *idx, 
         }
         next[jb]++;
     }
-    if (ok) {
-        b->nb = nb;
-        b->row_ptr = fs_malloc(((size_t)nb + 1) * sizeof *b->row_ptr);
-        int32_t total = 0;
-        for (int32_t i = 0; i < nb; i++) {
-            b->row_ptr[i] = total;
-            total += next[i];
-            next[i] = b->row_ptr[i];
-        }
-        b->row_ptr[nb] = total;
-        b->col = fs_malloc(((size_t)total + 1) * sizeof *b->col);
-        b->v = fs_malloc(9 * ((size_t)total + 1) * sizeof *b->v);
-        b->diag = fs_malloc(((size_t)nb + 1) * sizeof *b->diag);
-    }
+    if (ok)
+        block3_alloc(b, nb, next);
     /* pass 2: the blocks, a triple of rows of the node's three columns at a time */
     for (int32_t jb = 0; jb < nb && ok; jb++) {
         int32_t c = idx ? idx[3 * jb] : 3 * jb;
