@@ -1414,6 +1414,7 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->tip_node);
     free(w->tip_dir);
     free(w->tip_scale);
+    free(w->open);
     memset(w, 0, sizeof *w);
 }
 
@@ -1842,6 +1843,7 @@ int fs_wedge_subdivide(fs_wedge_model *w, const int32_t *elems, int32_t n, bool 
         if (ch.n_bisections == 0)
             break;
         *bisected += ch.n_bisections;
+        w->open_valid = false;
         grow_arrays(w, w->mesh->n_nodes, w->mesh->n_tris);
         for (int32_t q = 0; q < ch.n_new_nodes; q++) {
             int32_t i = ch.n_nodes_before + q;
@@ -1928,6 +1930,7 @@ static void mark_dirty(fs_wedge_model *w, const int32_t *nodes, int32_t nn)
 int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
 {
     double t0 = fs_seconds();
+    w->open_valid = false;
     int32_t n_free_old = w->n_free, n_fixed_old = w->n_fixed, n0 = c->n_nodes_before, e0 = c->n_tris_before;
     grow_arrays(w, w->mesh->n_nodes, w->mesh->n_tris);
     for (int32_t i = n0; i < w->n_nodes; i++) {

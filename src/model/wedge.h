@@ -203,6 +203,9 @@ typedef struct {
     double tips_unit;            /* mean edge length (cm) of the living elements at the first use of the
                                     sub-model or smoothing radius: their unit; 0 before */
     int64_t griffith_stops;      /* tips retired by the Griffith criterion */
+    uint8_t *open;               /* per node: 1 on a boundary edge of the mesh (a crack wall, a tip,
+                                    the domain's border), while open_valid (wedge_split.c) */
+    bool open_valid;             /* cleared by every change of the mesh's connectivity */
 } fs_wedge_model;
 
 /* Builds the model on mesh (borrowed, kept by pointer; its edges and rings must be built, as
@@ -376,7 +379,7 @@ double fs_wedge_split_max_ratio(fs_wedge_model *w);
  * exceeds 1 in a or b are evaluated: a ratio is convex along the blend (the largest eigenvalue of a
  * symmetric tensor is a convex function of it, and the stresses blend linearly), so it stays at most
  * the larger of its ends. */
-double fs_wedge_split_blend_ratio(const fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b,
+double fs_wedge_split_blend_ratio(fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b,
                                   double t);
 
 /* Re-factorizes the current matrix now (CHOLMOD; nothing with CG), dropping accumulated updates.

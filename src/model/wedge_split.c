@@ -184,17 +184,23 @@ static double cached_node_ratio(fs_wedge_model *w, int32_t i)
     return w->node_ratio[i];
 }
 
-/* open[i] = 1 for a node on a boundary edge of the mesh: a crack wall, a tip or the domain's border. */
-static uint8_t *open_nodes(const fs_wedge_model *w)
+/* w->open, brought up to date: open[i] = 1 for a node on a boundary edge of the mesh (a crack wall, a
+ * tip or the domain's border). The flags stay valid until the mesh changes (fs_wedge_apply_change,
+ * fs_wedge_subdivide), so the event search and the event share one pass over the mesh. */
+static const uint8_t *open_nodes(fs_wedge_model *w)
 {
     const fs_mesh *m = w->mesh;
-    uint8_t *open = fs_calloc((size_t)m->n_nodes + 1, 1);
-    for (int32_t h = 0; h < 3 * m->n_tris; h++)
-        if (m->adj[h] < 0) {
-            open[m->tri[h]] = 1;
-            open[m->tri[3 * (h / 3) + (h % 3 + 1) % 3]] = 1;
-        }
-    return open;
+    if (!w->open_valid) {
+        w->open = fs_realloc(w->open, (size_t)m->n_nodes + 1);
+        memset(w->open, 0, (size_t)m->n_nodes + 1);
+        for (int32_t h = 0; h < 3 * m->n_tris; h++)
+            if (m->adj[h] < 0) {
+                w->open[m->tri[h]] = 1;
+                w->open[m->tri[3 * (h / 3) + (h % 3 + 1) % 3]] = 1;
+            }
+        w->open_valid = true;
+    }
+    return w->open;
 }
 
 double fs_wedge_split_max_ratio(fs_wedge_model *w)
@@ -202,15 +208,14 @@ double fs_wedge_split_max_ratio(fs_wedge_model *w)
     double best = -INFINITY;
     for (int32_t k = 0; k < w->n_tips; k++)
         best = fmax(best, tip_ratio(w, w->tip_node[k], NULL) * w->tip_scale[k]);
-    uint8_t *open = open_nodes(w);
+    const uint8_t *open = open_nodes(w);
     for (int32_t i = 0; i < w->n_nodes; i++)
         if (!open[i])
             best = fmax(best, cached_node_ratio(w, i));
-    free(open);
     return best;
 }
 
-double fs_wedge_split_blend_ratio(const fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b,
+double fs_wedge_split_blend_ratio(fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b,
                                   double t)
 {
     FS_ASSERT(a->n_nodes == w->n_nodes && b->n_nodes == w->n_nodes && a->n_elems == w->n_elems &&
@@ -220,7 +225,7 @@ double fs_wedge_split_blend_ratio(const fs_wedge_model *w, const fs_wedge_snapsh
     double best = -INFINITY, bound = -INFINITY;
     for (int32_t k = 0; k < w->n_tips; k++)
         best = fmax(best, tip_ratio_of(w, &st, w->tip_node[k], NULL) * w->tip_scale[k]);
-    uint8_t *open = open_nodes(w);
+    const uint8_t *open = open_nodes(w);
     for (int32_t i = 0; i < w->n_nodes; i++) {
         if (open[i])
             continue;
@@ -230,7 +235,6 @@ double fs_wedge_split_blend_ratio(const fs_wedge_model *w, const fs_wedge_snapsh
         else
             bound = fmax(bound, end);
     }
-    free(open);
     return best > 1.0 ? best : fmax(best, bound);
 }
 
@@ -696,7 +700,7 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
     fs_mesh *m = w->mesh;
     fs_wedge_frame f;
     fs_wedge_frame_at(w, n, &f);
-    uint8_t *open = open_nodes(w);
+    const uint8_t *open = open_nodes(w);
     cut_state cs = {w, m->n_nodes, m->n_tris, {0}, NULL, {0}, fs_calloc((size_t)m->n_tris + 1, 1), {0}, m->n_tris};
     int cuts = 0;
     for (int r = 0; r < n_rays; r++) {
@@ -723,7 +727,6 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
         cuts++;
     }
     if (cuts == 0) {
-        free(open);
         cut_free(&cs);
         return 0;
     }
@@ -754,22 +757,24 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
             ilist_push(&changed, t);
     fs_wedge_change ch = {cs.n_nodes0, cs.n_tris0, cs.node_parent.v, cs.node_weight, cs.tri_parent.v,
                           changed.v, changed.n};
+    bool end_open[2] = {false, false}; /* before the cut: the change makes the flags stale */
+    for (int r = 0; r < n_rays; r++)
+        end_open[r] = ends[r] >= 0 && ends[r] < cs.n_nodes0 && open[ends[r]];
     int rc = fs_wedge_apply_change(w, &ch);
     free(changed.v);
     tip_remove(w, n);
     for (int r = 0; r < n_rays && cuts > 0; r++) {
         if (ends[r] < 0)
             continue;
-        if (sectors_far[r] > 1 || (ends[r] < cs.n_nodes0 && open[ends[r]]))
+        if (sectors_far[r] > 1 || end_open[r])
             tip_remove(w, ends[r]);
         if (sectors_far[r] == 1)
             tip_add(w, ends[r], rays[r]);
     }
-    free(open);
     cut_free(&cs);
     return rc < 0 ? -1 : cuts;
 fail:
-    free(open);
+    w->open_valid = false;
     cut_free(&cs);
     return -1;
 }
@@ -890,7 +895,7 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed)
         free(tried);
     }
     if (pick < 0) {
-        uint8_t *open = open_nodes(w);
+        const uint8_t *open = open_nodes(w);
         double *r = fs_malloc(((size_t)w->n_nodes + 1) * sizeof *r);
         for (int32_t i = 0; i < w->n_nodes; i++) {
             r[i] = open[i] ? NAN : cached_node_ratio(w, i);
@@ -899,7 +904,6 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed)
         }
         pick = fs_rank_pick(r, NULL, w->n_nodes, w->cfg.preset.seed);
         free(r);
-        free(open);
     }
     if (pick < 0)
         return 1;
