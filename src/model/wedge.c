@@ -240,7 +240,7 @@ static void build_node_elems(fs_wedge_model *w)
         w->node_elem_start[i + 1] += w->node_elem_start[i] + NODE_ELEM_SLACK;
     int32_t *fill = fs_malloc(((size_t)n + 1) * sizeof *fill);
     memcpy(fill, w->node_elem_start, ((size_t)n + 1) * sizeof *fill);
-    w->node_elem_capacity = w->node_elem_start[n];
+    w->node_elem_used = w->node_elem_capacity = w->node_elem_start[n];
     w->node_elem = fs_malloc(((size_t)w->node_elem_capacity + 1) * sizeof *w->node_elem);
     for (int32_t e = 0; e < w->n_elems; e++)
         for (int c = 0; c < 3; c++) {
@@ -250,9 +250,24 @@ static void build_node_elems(fs_wedge_model *w)
                 continue;
             w->node_elem[fill[node]++] = e;
         }
-    for (int32_t i = 0; i < n; i++)
+    w->node_elem_room = fs_realloc(w->node_elem_room, ((size_t)n + 1) * sizeof *w->node_elem_room);
+    for (int32_t i = 0; i < n; i++) {
         w->node_elem_count[i] = fill[i] - w->node_elem_start[i];
+        w->node_elem_room[i] = w->node_elem_start[i + 1] - w->node_elem_start[i];
+    }
     free(fill);
+}
+
+/* Entries of node_elem from node_elem_used on for a list of `room`; returns its start. */
+static int32_t node_elem_take(fs_wedge_model *w, int32_t room)
+{
+    if (w->node_elem_used + room > w->node_elem_capacity) {
+        w->node_elem_capacity = 2 * (w->node_elem_used + room);
+        w->node_elem = fs_realloc(w->node_elem, ((size_t)w->node_elem_capacity + 1) * sizeof *w->node_elem);
+    }
+    int32_t start = w->node_elem_used;
+    w->node_elem_used += room;
+    return start;
 }
 
 static int cmp_elem(const void *a, const void *b)
@@ -264,8 +279,9 @@ static int cmp_elem(const void *a, const void *b)
 /* Brings node_elem up to a change that appended nodes from n0 and elements from e0 and rewrote the
  * corners of the listed elements only, so that the nodes whose lists change are the corners of the
  * changed and new elements and those that lost an element (given in lost, nl of them): their lists
- * are recomputed from their old ones and those elements, in place while they fit their room (new
- * nodes get theirs at the end), else everything is built again. */
+ * are recomputed from their old ones and those elements, in place while they fit their room; a list
+ * that outgrows it, and a new node's, gets room at the end of node_elem. Once the lists abandoned
+ * there take half of it, everything is laid out again. */
 static void update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const int32_t *changed, int32_t n_changed,
                               const int32_t *lost, int32_t nl)
 {
@@ -273,20 +289,15 @@ static void update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const i
     int32_t n_new_elems = w->n_elems - e0;
     int32_t *cand = fs_malloc(((size_t)n_changed + n_new_elems + 64) * sizeof *cand);
     int32_t cap_cand = n_changed + n_new_elems + 64;
-    /* the start of every new node: after the last list, with room */
     w->node_elem_start = fs_realloc(w->node_elem_start, ((size_t)w->n_nodes + 1) * sizeof *w->node_elem_start);
+    w->node_elem_room = fs_realloc(w->node_elem_room, ((size_t)w->n_nodes + 1) * sizeof *w->node_elem_room);
     for (int32_t i = n0; i < w->n_nodes; i++) {
-        w->node_elem_start[i + 1] = w->node_elem_start[i] + NODE_ELEM_SLACK;
+        w->node_elem_start[i] = node_elem_take(w, NODE_ELEM_SLACK);
+        w->node_elem_room[i] = NODE_ELEM_SLACK;
         w->node_elem_count[i] = 0;
     }
-    int32_t total = w->node_elem_start[w->n_nodes];
-    if (total > w->node_elem_capacity) {
-        w->node_elem_capacity = total + total / 2;
-        w->node_elem = fs_realloc(w->node_elem, ((size_t)w->node_elem_capacity + 1) * sizeof *w->node_elem);
-    }
-    bool fits = true;
     int32_t n_touch = 3 * (n_changed + n_new_elems) + nl;
-    for (int32_t t = 0; t < n_touch && fits; t++) {
+    for (int32_t t = 0; t < n_touch; t++) {
         int32_t i;
         if (t < 3 * n_changed)
             i = m->tri[3 * (size_t)changed[t / 3] + t % 3];
@@ -310,15 +321,15 @@ static void update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const i
         for (int32_t q = 0; q < nc; q++)
             if ((kept == 0 || cand[kept - 1] != cand[q]) && fs_mesh_corner_of(m, cand[q], i) >= 0)
                 cand[kept++] = cand[q];
-        if (kept > w->node_elem_start[i + 1] - start) {
-            fits = false;
-            break;
+        if (kept > w->node_elem_room[i]) {
+            w->node_elem_room[i] = kept + NODE_ELEM_SLACK;
+            w->node_elem_start[i] = start = node_elem_take(w, w->node_elem_room[i]);
         }
         memcpy(w->node_elem + start, cand, (size_t)kept * sizeof *cand);
         w->node_elem_count[i] = kept;
     }
     free(cand);
-    if (!fits)
+    if (w->node_elem_used > 2 * (3 * w->n_elems + NODE_ELEM_SLACK * w->n_nodes))
         build_node_elems(w);
 }
 
@@ -1403,6 +1414,7 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->node_elem_start);
     free(w->node_elem);
     free(w->node_elem_count);
+    free(w->node_elem_room);
     fs_sparse_matrix_free(&w->k_free);
     coupling_free(&w->k_fb);
     free(w->load);

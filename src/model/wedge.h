@@ -123,10 +123,12 @@ typedef struct {
     uint8_t *pinned;             /* per node: 1 if its top node is prescribed too (patch tests), else 0 */
     double *prescribed;          /* 6 per node: prescribed displacement of fixed DOFs besides growth (cm) */
     double *u;                   /* 6 per node: displacement at the current equilibrium (cm) */
-    int32_t *node_elem_start;    /* n_nodes + 1: elements using each node (CSR, ascending, dead ones too) */
-    int32_t *node_elem_count;    /* per node: entries used in node_elem from node_elem_start[i] */
+    int32_t *node_elem_start;    /* per node: where its list of the elements using it (ascending,
+                                    dead ones too) starts in node_elem */
+    int32_t *node_elem_count;    /* per node: entries of its list */
+    int32_t *node_elem_room;     /* per node: entries its list may grow to in place */
     int32_t *node_elem;
-    int32_t node_elem_capacity;  /* entries node_elem has room for */
+    int32_t node_elem_used, node_elem_capacity; /* entries of node_elem handed out, allocated */
 
     /* Elements. */
     int32_t n_elems;
