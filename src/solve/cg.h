@@ -25,8 +25,8 @@ fs_cg_params fs_cg_params_default(void);
  * step's solution) and the solution on return; b and x have a->n elements and must not overlap.
  * Convergence is judged on the true residual, recomputed when the recurrence claims convergence. If
  * relative_residual is not NULL it receives the final ||b - A x|| / ||b|| (Euclidean norms, also when
- * params.max_residual is the rule). Scratch memory ((3 + block) n doubles) is
- * allocated per call. Returns the number of iterations (0 if the guess already satisfies the tolerance;
+ * params.max_residual is the rule). Scratch memory ((3 + block) n doubles, and with block 3 a copy
+ * of the matrix in 3x3 blocks, both triangles, for the products) is allocated per call. Returns the number of iterations (0 if the guess already satisfies the tolerance;
  * x = 0 if b = 0), or -1 with FS_ERR_INTERNAL: "cg: no convergence after N iterations (relative residual
  * r)", or when a diagonal entry or block, or a curvature p'Ap is not positive (A is not positive definite). */
 int fs_cg_solve(const fs_sparse_matrix *a, const double *b, double *x, fs_cg_params params,
