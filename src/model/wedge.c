@@ -270,10 +270,35 @@ static int32_t node_elem_take(fs_wedge_model *w, int32_t room)
     return start;
 }
 
-static int cmp_elem(const void *a, const void *b)
+static int cmp_int32(const void *a, const void *b)
 {
     int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
     return (x > y) - (x < y);
+}
+
+int32_t fs_wedge_elems_at(const fs_wedge_model *w, int32_t i, const int32_t *changed, int32_t n_changed,
+                          int32_t first_new, bool living, int32_t *out)
+{
+    const fs_mesh *m = w->mesh;
+    int32_t n = 0;
+    if (i < w->n_nodes)
+        for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++)
+            out[n++] = w->node_elem[p];
+    for (int32_t q = 0; q < n_changed; q++)
+        out[n++] = changed[q];
+    for (int32_t t = first_new; t < m->n_tris; t++)
+        out[n++] = t;
+    if (n > 1)
+        qsort(out, (size_t)n, sizeof *out, cmp_int32);
+    int32_t kept = 0;
+    for (int32_t q = 0; q < n; q++) {
+        int32_t t = out[q];
+        if ((kept > 0 && out[kept - 1] == t) || (living && t < w->n_elems && w->state[t] != FS_WEDGE_ALIVE) ||
+            fs_mesh_corner_of(m, t, i) < 0)
+            continue;
+        out[kept++] = t;
+    }
+    return kept;
 }
 
 /* Brings node_elem up to a change that appended nodes from n0 and elements from e0 and rewrote the
@@ -305,22 +330,12 @@ static void update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const i
             i = m->tri[3 * (size_t)(e0 + (t - 3 * n_changed) / 3) + t % 3];
         else
             i = lost[t - 3 * (n_changed + n_new_elems)];
-        int32_t start = w->node_elem_start[i], count = w->node_elem_count[i], nc = 0;
+        int32_t start = w->node_elem_start[i], count = w->node_elem_count[i];
         if (count + n_changed + n_new_elems > cap_cand) {
             cap_cand = count + n_changed + n_new_elems;
             cand = fs_realloc(cand, (size_t)cap_cand * sizeof *cand);
         }
-        for (int32_t p = start; p < start + count; p++)
-            cand[nc++] = w->node_elem[p];
-        for (int32_t q = 0; q < n_changed; q++)
-            cand[nc++] = changed[q];
-        for (int32_t e = e0; e < w->n_elems; e++)
-            cand[nc++] = e;
-        qsort(cand, (size_t)nc, sizeof *cand, cmp_elem);
-        int32_t kept = 0;
-        for (int32_t q = 0; q < nc; q++)
-            if ((kept == 0 || cand[kept - 1] != cand[q]) && fs_mesh_corner_of(m, cand[q], i) >= 0)
-                cand[kept++] = cand[q];
+        int32_t kept = fs_wedge_elems_at(w, i, changed, n_changed, e0, false, cand);
         if (kept > w->node_elem_room[i]) {
             w->node_elem_room[i] = kept + NODE_ELEM_SLACK;
             w->node_elem_start[i] = start = node_elem_take(w, w->node_elem_room[i]);
@@ -456,6 +471,7 @@ static void coupling_from_csc(fs_wedge_coupling *c, const fs_sparse_matrix *a, i
         c->len[k] = m;
         c->cap[k] = m + COUPLING_SLACK;
         c->used += (size_t)c->cap[k];
+        c->entries += (size_t)m;
     }
     c->n = n;
 }
@@ -499,15 +515,14 @@ static void coupling_insert(fs_wedge_coupling *c, int32_t k, int32_t row)
     c->row[at] = row;
     c->value[at] = 0.0;
     c->len[k]++;
+    c->entries++;
 }
 
 /* Lays the pool out afresh (each column with COUPLING_SLACK room) once moved columns' holes take
  * more than half of it. */
 static void coupling_compact(fs_wedge_coupling *c)
 {
-    size_t live = 0;
-    for (int32_t k = 0; k < c->n; k++)
-        live += (size_t)c->len[k] + COUPLING_SLACK;
+    size_t live = c->entries + (size_t)COUPLING_SLACK * (size_t)c->n;
     if (2 * live >= c->used)
         return;
     int32_t *row = fs_malloc((live + 1) * sizeof *row);
@@ -1437,12 +1452,6 @@ void fs_wedge_free(fs_wedge_model *w)
  * bounds the round-off that downdates accumulate and restores the faster supernodal solves. */
 #define UPDOWN_LIMIT 128
 
-static int cmp_int32(const void *a, const void *b)
-{
-    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
-    return (x > y) - (x < y);
-}
-
 /* design: thesis Algorithm 7 (removal by reconstruction), generalised to any set of nodes whose
  * elements changed. Every entry of the system coupling two DOFs of the nodes in S, and every load at
  * those DOFs, is set to zero and rebuilt from the living elements touching S, in ascending element
@@ -1651,7 +1660,7 @@ int fs_wedge_remove(fs_wedge_model *w, int32_t e)
  * plus the pairs of the changed elements it lacks and the diagonals of the new DOFs. A cut or a
  * bisection couples old nodes only where they were coupled already, so those pairs are in the new
  * nodes' columns, which come last: the old columns stay where they are. A pair of old nodes not
- * coupled before (a collapsed edge) moves the columns behind it, by a merge from the back that never
+ * coupled before (an edge flip, say) moves the columns behind it, by a merge from the back that never
  * overwrites an entry not yet read. K_fb's new entries go into their columns in place
  * (fs_wedge_coupling). The arrays grow geometrically, so a cut costs what its elements touch, not a
  * pass over the matrix. Entries whose element vanished stay in the pattern as zeros; new entries are

@@ -102,6 +102,7 @@ typedef struct {
     int32_t *row;                /* free row of each slot */
     double *value;               /* value of each slot */
     size_t used, size;           /* slots handed out (holes left by moved columns included), allocated */
+    size_t entries;              /* sum of len */
 } fs_wedge_coupling;
 
 typedef struct {
@@ -338,6 +339,14 @@ typedef struct {
     const int32_t *changed;
     int32_t n_changed;
 } fs_wedge_change;
+
+/* The elements with node i as a corner in the mesh as it is now, ascending: found among node_elem's
+ * list for i (i < n_nodes), the n_changed listed elements and the triangles from first_new to
+ * mesh->n_tris - 1, which must include every element whose corners changed since node_elem was
+ * built. With living, removed elements are left out (triangles beyond n_elems count as living). out
+ * needs room for all three; returns the count. */
+int32_t fs_wedge_elems_at(const fs_wedge_model *w, int32_t i, const int32_t *changed, int32_t n_changed,
+                          int32_t first_new, bool living, int32_t *out);
 
 /* Brings the model up to a mesh change (see fs_wedge_change): extends the node and element arrays
  * (new nodes get the interpolated thickness factor, displacement, prescribed values and pin flag of

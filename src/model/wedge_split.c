@@ -393,38 +393,17 @@ static void set_corner(fs_mesh *m, int32_t t, int c, int32_t i, const double p[3
     m->shift[6 * (size_t)t + 2 * c + 1] = (int8_t)lround((p[1] - q[1]) / ey);
 }
 
-static int cmp_int32(const void *a, const void *b)
-{
-    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
-    return (x > y) - (x < y);
-}
-
 /* Living triangles that have node i as a corner, ascending, in the mesh as the cut has changed it so
- * far: those the model's node_elem lists for i (the mesh before the cut), the changed ones and the
- * new ones, kept where i is still or now a corner (every corner the cut rewrites is in a changed or
- * new triangle). */
+ * far (every corner the cut rewrites is in a changed or new triangle). */
 static void tris_at(const cut_state *cs, int32_t i, ilist *out)
 {
     const fs_wedge_model *w = cs->w;
-    const fs_mesh *m = w->mesh;
-    out->n = 0;
-    if (i < w->n_nodes)
-        for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++)
-            ilist_push(out, w->node_elem[p]);
-    for (int32_t q = 0; q < cs->changed_list.n; q++)
-        ilist_push(out, cs->changed_list.v[q]);
-    for (int32_t t = cs->n_tris0; t < m->n_tris; t++)
-        ilist_push(out, t);
-    qsort(out->v, (size_t)out->n, sizeof *out->v, cmp_int32);
-    int32_t kept = 0;
-    for (int32_t q = 0; q < out->n; q++) {
-        int32_t t = out->v[q];
-        if ((kept > 0 && out->v[kept - 1] == t) || !(t >= w->n_elems || w->state[t] == FS_WEDGE_ALIVE) ||
-            fs_mesh_corner_of(m, t, i) < 0)
-            continue;
-        out->v[kept++] = t;
+    int32_t room = (i < w->n_nodes ? w->node_elem_count[i] : 0) + cs->changed_list.n + (w->mesh->n_tris - cs->n_tris0);
+    if (out->cap < room) {
+        out->cap = room;
+        out->v = fs_realloc(out->v, (size_t)out->cap * sizeof *out->v);
     }
-    out->n = kept;
+    out->n = fs_wedge_elems_at(w, i, cs->changed_list.v, cs->changed_list.n, cs->n_tris0, true, out->v);
 }
 
 /* Corner c of triangle t relative to corner cn, in the 2-D frame. */
