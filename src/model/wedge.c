@@ -321,15 +321,22 @@ static void update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const i
         w->node_elem_room[i] = NODE_ELEM_SLACK;
         w->node_elem_count[i] = 0;
     }
-    int32_t n_touch = 3 * (n_changed + n_new_elems) + nl;
+    /* the nodes whose lists change, each once */
+    int32_t n_touch = 0, *touch = fs_malloc((3 * ((size_t)n_changed + n_new_elems) + (size_t)nl + 1) * sizeof *touch);
+    for (int32_t q = 0; q < n_changed; q++)
+        for (int k = 0; k < 3; k++)
+            touch[n_touch++] = m->tri[3 * (size_t)changed[q] + k];
+    for (int32_t e = e0; e < w->n_elems; e++)
+        for (int k = 0; k < 3; k++)
+            touch[n_touch++] = m->tri[3 * (size_t)e + k];
+    for (int32_t q = 0; q < nl; q++)
+        touch[n_touch++] = lost[q];
+    if (n_touch > 1)
+        qsort(touch, (size_t)n_touch, sizeof *touch, cmp_int32);
     for (int32_t t = 0; t < n_touch; t++) {
-        int32_t i;
-        if (t < 3 * n_changed)
-            i = m->tri[3 * (size_t)changed[t / 3] + t % 3];
-        else if (t < 3 * (n_changed + n_new_elems))
-            i = m->tri[3 * (size_t)(e0 + (t - 3 * n_changed) / 3) + t % 3];
-        else
-            i = lost[t - 3 * (n_changed + n_new_elems)];
+        int32_t i = touch[t];
+        if (t > 0 && touch[t - 1] == i)
+            continue;
         int32_t start = w->node_elem_start[i], count = w->node_elem_count[i];
         if (count + n_changed + n_new_elems > cap_cand) {
             cap_cand = count + n_changed + n_new_elems;
@@ -343,6 +350,7 @@ static void update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const i
         memcpy(w->node_elem + start, cand, (size_t)kept * sizeof *cand);
         w->node_elem_count[i] = kept;
     }
+    free(touch);
     free(cand);
     if (w->node_elem_used > 2 * (3 * w->n_elems + NODE_ELEM_SLACK * w->n_nodes))
         build_node_elems(w);
