@@ -14,14 +14,16 @@
  * than the closed-form cubic: every rotation is an exact orthogonal transform, so the result stays
  * accurate for repeated and nearly repeated eigenvalues, where the trigonometric cubic formula loses
  * the eigenvectors. A zero off-diagonal entry is never rotated, so diagonal input is returned exactly.
- * m is the full symmetric matrix, updated in place to diagonal form; v accumulates the rotations
- * (columns are eigenvectors). */
-static void jacobi3(double m[3][3], double v[3][3])
+ * m is the full symmetric matrix, updated in place to diagonal form; v, unless NULL, accumulates the
+ * rotations (columns are eigenvectors). The rotations never read v, so the eigenvalues are the same
+ * with or without it. */
+static void jacobi3(double m[3][3], double (*v)[3])
 {
     static const int pairs[3][3] = {{0, 1, 2}, {0, 2, 1}, {1, 2, 0}}; /* p, q, and the third index r */
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            v[i][j] = i == j ? 1.0 : 0.0;
+    if (v)
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                v[i][j] = i == j ? 1.0 : 0.0;
     for (int sweep = 0; sweep < JACOBI_MAX_SWEEPS; sweep++) {
         if (m[0][1] == 0.0 && m[0][2] == 0.0 && m[1][2] == 0.0)
             return;
@@ -53,7 +55,7 @@ static void jacobi3(double m[3][3], double v[3][3])
             double grp = m[r][p], grq = m[r][q];
             m[r][p] = m[p][r] = grp - s * (grq + grp * tau);
             m[r][q] = m[q][r] = grq + s * (grp - grq * tau);
-            for (int i = 0; i < 3; i++) {
+            for (int i = 0; v && i < 3; i++) {
                 double vp = v[i][p], vq = v[i][q];
                 v[i][p] = vp - s * (vq + vp * tau);
                 v[i][q] = vq + s * (vp - vq * tau);
@@ -93,7 +95,7 @@ int fs_eigen_sym3(const double a[9], double values[3], double vectors[9])
     m[0][1] = m[1][0] = a[1];
     m[1][2] = m[2][1] = a[5];
     m[0][2] = m[2][0] = a[2];
-    jacobi3(m, v);
+    jacobi3(m, vectors ? v : NULL);
 
     /* Sort descending; a stable three-element insertion sort keeps equal values in axis order. */
     int order[3] = {0, 1, 2};

@@ -99,7 +99,7 @@ static double point_ratio(const fs_wedge_model *w, const stresses *st, int32_t e
 {
     double sigma[3], dirs[9], v[6];
     stress_at(st, e, c, v);
-    if (fs_eigen_principal_stress(v, sigma, dirs) < 0) {
+    if (fs_eigen_principal_stress(v, sigma, m ? dirs : NULL) < 0) {
         fs_error_clear();
         return -INFINITY;
     }
@@ -153,7 +153,7 @@ static double node_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t
     for (int k = 0; k < 6; k++)
         s[k] /= count;
     double sigma[3], dirs[9];
-    if (fs_eigen_principal_stress(s, sigma, dirs) < 0) {
+    if (fs_eigen_principal_stress(s, sigma, m ? dirs : NULL) < 0) {
         fs_error_clear();
         return -INFINITY;
     }
