@@ -4,6 +4,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdbool.h>
+#include <string.h>
 
 #include "base/error.h"
 
@@ -66,17 +67,18 @@ static bool converged(const fs_cg_params *params, int32_t n, const double *r, do
     return params->max_residual > 0.0 ? max_abs(n, r) <= params->max_residual : rnorm <= limit;
 }
 
-/* design: with block = 3 the matrix is first copied into 3x3 blocks stored in both triangles, one
- * row of blocks per node (block compressed rows). Its product reads one column index per nine values
- * and writes each output once, where the upper-triangle product (fs_sparse_matvec) reads an index per
- * value and scatters every off-diagonal product into a second row: about twice as fast for the
- * elasticity systems, and the copy costs about one product. The sums run in a fixed order, so results
- * are deterministic. */
+/* design: with block = 3 the matrix is first copied into 3x3 blocks, one row of blocks per node
+ * (block compressed rows) holding the blocks on and above the diagonal, the diagonal block first and
+ * whole. The product reads one column index per nine values, and each stored off-diagonal block
+ * serves both its row (B x_j) and, transposed, its column (B^T x_i): where the upper-triangle product
+ * (fs_sparse_matvec) reads an index per value, and a copy in both triangles reads every value twice,
+ * this reads the half of the matrix once, and the product is bound by reading the matrix. The copy
+ * costs about one product. The sums run in a fixed order, so results are deterministic. */
 typedef struct {
     int32_t nb;       /* rows (and columns) of blocks: n / 3 */
     int32_t *row_ptr; /* nb + 1 offsets into col and v */
-    int32_t *col;     /* block column of each stored block */
-    int32_t *diag;    /* per block row: the slot of its diagonal block, -1 if the matrix has none */
+    int32_t *col;     /* block column of each stored block, ascending (>= its row) */
+    int32_t *diag;    /* per block row: the slot of its diagonal block (its first), -1 if it has none */
     double *v;        /* 9 per block, row-major */
 } block3_matrix;
 
@@ -108,33 +110,31 @@ static void block3_alloc(block3_matrix *b, int32_t nb, int32_t *next)
         b->diag[i] = -1;
 }
 
-/* Copies the upper-triangle CSC a (a->n a multiple of 3) into b, both triangles; absent entries of a
- * stored block are 0. */
+/* Copies the upper-triangle CSC a (a->n a multiple of 3) into b; absent entries of a stored block
+ * are 0. */
 static void block3_build(const fs_sparse_matrix *a, block3_matrix *b)
 {
     int32_t nb = a->n / 3;
     int32_t *mark = fs_malloc(((size_t)nb + 1) * sizeof *mark);
     int32_t *next = fs_calloc((size_t)nb + 1, sizeof *next);
     int32_t *slot = fs_malloc(((size_t)nb + 1) * sizeof *slot);
-    int32_t *slot_t = fs_malloc(((size_t)nb + 1) * sizeof *slot_t);
     for (int32_t i = 0; i < nb; i++)
         mark[i] = -1;
-    /* pass 1: blocks per block row (upper block (I, J) and, off the diagonal, its transpose) */
+    /* pass 1: blocks per block row (block (I, J) with I <= J, as the entries of a are) */
     for (int32_t jb = 0; jb < nb; jb++)
         for (int32_t j = 3 * jb; j < 3 * jb + 3; j++)
             for (int32_t p = a->col_ptr[j]; p < a->col_ptr[j + 1]; p++) {
                 int32_t ib = a->row_idx[p] / 3;
-                if (mark[ib] == jb)
-                    continue;
-                mark[ib] = jb;
-                next[ib]++;
-                if (ib != jb)
-                    next[jb]++;
+                if (mark[ib] != jb) {
+                    mark[ib] = jb;
+                    next[ib]++;
+                }
             }
     block3_alloc(b, nb, next);
     for (int32_t i = 0; i < nb; i++)
         mark[i] = -1;
-    /* pass 2: place the blocks and their values */
+    /* pass 2: place the blocks (by ascending block column: the diagonal block first) and their values;
+     * the diagonal block gets both triangles */
     for (int32_t jb = 0; jb < nb; jb++)
         for (int32_t j = 3 * jb; j < 3 * jb + 3; j++)
             for (int32_t p = a->col_ptr[j]; p < a->col_ptr[j + 1]; p++) {
@@ -143,22 +143,17 @@ static void block3_build(const fs_sparse_matrix *a, block3_matrix *b)
                     mark[ib] = jb;
                     slot[ib] = next[ib]++;
                     b->col[slot[ib]] = jb;
-                    if (ib != jb) {
-                        slot_t[ib] = next[jb]++;
-                        b->col[slot_t[ib]] = ib;
-                    } else {
-                        slot_t[ib] = slot[ib];
+                    if (ib == jb)
                         b->diag[ib] = slot[ib];
-                    }
                 }
-                double v = a->values[p];
-                b->v[9 * (size_t)slot[ib] + 3 * (i % 3) + j % 3] = v;
-                b->v[9 * (size_t)slot_t[ib] + 3 * (j % 3) + i % 3] = v;
+                double *v = b->v + 9 * (size_t)slot[ib];
+                v[3 * (i % 3) + j % 3] = a->values[p];
+                if (ib == jb)
+                    v[3 * (j % 3) + i % 3] = a->values[p];
             }
     free(mark);
     free(next);
     free(slot);
-    free(slot_t);
 }
 
 /* design: the elasticity systems come in whole 3x3 blocks: a node's three unknowns are consecutive
@@ -214,16 +209,15 @@ static bool block3_build_regular(const fs_sparse_matrix *a, const int32_t *idx, 
         const int32_t *rows = a->row_idx + a->col_ptr[(idx ? idx[3 * jb] : 3 * jb) + 2];
         for (int32_t q = 0; q < kk[jb]; q++) {
             int32_t i = idx ? map[rows[3 * q]] : rows[3 * q];
-            if (i < 0)
-                continue;
-            next[i / 3]++;
-            next[jb]++;
+            if (i >= 0)
+                next[i / 3]++;
         }
         next[jb]++;
     }
     if (ok)
         block3_alloc(b, nb, next);
-    /* pass 2: the blocks, a triple of rows of the node's three columns at a time */
+    /* pass 2: the blocks, a triple of rows of the node's three columns at a time (by ascending block
+     * column, so a row's diagonal block comes first); the diagonal block gets both triangles */
     for (int32_t jb = 0; jb < nb && ok; jb++) {
         int32_t c = idx ? idx[3 * jb] : 3 * jb;
         const int32_t *p = a->col_ptr + c;
@@ -232,10 +226,9 @@ static bool block3_build_regular(const fs_sparse_matrix *a, const int32_t *idx, 
             if (ib < 0)
                 continue;
             ib /= 3;
-            int32_t up = next[ib]++, lo = ib != jb ? next[jb]++ : up;
-            b->col[up] = jb;
-            b->col[lo] = ib;
-            double *u = b->v + 9 * (size_t)up, *t = b->v + 9 * (size_t)lo;
+            int32_t slot = next[ib]++;
+            b->col[slot] = jb;
+            double *u = b->v + 9 * (size_t)slot;
             for (int l = 0; l < 3; l++)
                 for (int r = 0; r < 3; r++) {
                     /* entry (row 3 ib + r, column 3 jb + l); the diagonal block holds r <= l only */
@@ -243,10 +236,11 @@ static bool block3_build_regular(const fs_sparse_matrix *a, const int32_t *idx, 
                         continue;
                     double v = a->values[p[l] + 3 * q + r];
                     u[3 * r + l] = v;
-                    t[3 * l + r] = v;
+                    if (ib == jb)
+                        u[3 * l + r] = v;
                 }
             if (ib == jb)
-                b->diag[jb] = up;
+                b->diag[jb] = slot;
         }
     }
     if (idx)
@@ -257,19 +251,35 @@ static bool block3_build_regular(const fs_sparse_matrix *a, const int32_t *idx, 
     return ok;
 }
 
-static void block3_matvec(const block3_matrix *b, const double *x, double *y)
+/* y = B x: row I adds B_II x_I and, for each block above the diagonal, B_IJ x_J to y_I and B_IJ^T x_I
+ * to y_J, which is complete once row J begins (J > I). */
+static void block3_matvec(const block3_matrix *restrict b, const double *restrict x, double *restrict y)
 {
+    memset(y, 0, 3 * (size_t)b->nb * sizeof *y);
     for (int32_t ib = 0; ib < b->nb; ib++) {
-        double y0 = 0.0, y1 = 0.0, y2 = 0.0;
-        for (int32_t p = b->row_ptr[ib]; p < b->row_ptr[ib + 1]; p++) {
+        double *yi = y + 3 * (size_t)ib;
+        const double x0 = x[3 * (size_t)ib], x1 = x[3 * (size_t)ib + 1], x2 = x[3 * (size_t)ib + 2];
+        double y0 = yi[0], y1 = yi[1], y2 = yi[2];
+        int32_t p = b->row_ptr[ib];
+        if (b->diag[ib] == p) {
+            const double *v = b->v + 9 * (size_t)p++;
+            y0 += v[0] * x0 + v[1] * x1 + v[2] * x2;
+            y1 += v[3] * x0 + v[4] * x1 + v[5] * x2;
+            y2 += v[6] * x0 + v[7] * x1 + v[8] * x2;
+        }
+        for (; p < b->row_ptr[ib + 1]; p++) {
             const double *v = b->v + 9 * (size_t)p, *xj = x + 3 * (size_t)b->col[p];
+            double *yj = y + 3 * (size_t)b->col[p];
             y0 += v[0] * xj[0] + v[1] * xj[1] + v[2] * xj[2];
             y1 += v[3] * xj[0] + v[4] * xj[1] + v[5] * xj[2];
             y2 += v[6] * xj[0] + v[7] * xj[1] + v[8] * xj[2];
+            yj[0] += v[0] * x0 + v[3] * x1 + v[6] * x2;
+            yj[1] += v[1] * x0 + v[4] * x1 + v[7] * x2;
+            yj[2] += v[2] * x0 + v[5] * x1 + v[8] * x2;
         }
-        y[3 * ib] = y0;
-        y[3 * ib + 1] = y1;
-        y[3 * ib + 2] = y2;
+        yi[0] = y0;
+        yi[1] = y1;
+        yi[2] = y2;
     }
 }
 
