@@ -234,6 +234,48 @@ static void test_principal_stress(void)
     CHECK_NEAR(s[2], -0.001, 1e-18);
 }
 
+/* The cheap bound of the largest principal stress never falls below the Jacobi value (the kernel's
+ * own, bit for bit), whatever the level, and is within its margin of it where it exceeds the level:
+ * random stresses, and prescribed spectra with repeated and nearly repeated eigenvalues. */
+static void check_bound(const double a[9], double scale)
+{
+    const double s[6] = {a[0], a[4], a[8], a[1], a[5], a[2]};
+    double sigma[3];
+    CHECK(fs_eigen_principal_stress(s, sigma, NULL) == 0);
+    const double levels[] = {-INFINITY, sigma[0] - 1e-3 * scale, sigma[0], sigma[0] + 1e-3 * scale, INFINITY};
+    for (int k = 0; k < 5; k++) {
+        double b = fs_eigen_principal_bound(s, levels[k]);
+        CHECK_MSG(b >= sigma[0], "bound %.17g below %.17g at level %g", b, sigma[0], levels[k]);
+        if (b > levels[k])
+            CHECK_MSG(b - sigma[0] <= 3e-6 * scale, "bound %.17g loose over %.17g (scale %g)", b, sigma[0], scale);
+    }
+}
+
+static void test_principal_bound(void)
+{
+    for (uint64_t m = 0; m < 2000; m++) {
+        double a[9];
+        for (int i = 0; i < 3; i++)
+            for (int j = i; j < 3; j++)
+                a[3 * i + j] = a[3 * j + i] = fs_rand_range(9, FS_RNG_TEST, 9 * m + 3 * (uint64_t)i + (uint64_t)j, -1, 1);
+        check_bound(a, 3.0);
+    }
+    static const double spectra[][3] = {{3, 1, -2}, {1, 1, -2}, {4, -1, -1}, {2, 2, 2},     {1 + 1e-13, 1, 0.5},
+                                        {1e-9, 0, -1e-9}, {1e6, 1, 1e-6}, {5, 5, 5 - 1e-12}, {0, 0, 0}};
+    for (uint64_t k = 0; k < sizeof spectra / sizeof spectra[0]; k++)
+        for (uint64_t rot = 0; rot < 40; rot++) {
+            double q[9], a[9];
+            random_rotation(1000 + 40 * k + rot, q);
+            compose(q, spectra[k], a);
+            check_bound(a, fabs(spectra[k][0]) + fabs(spectra[k][2]) + 1e-300);
+        }
+    /* Axis-aligned stresses are bounded exactly by their largest entry at the closed form. */
+    const double axis[6] = {2, -1, 0.5, 0, 0, 0};
+    CHECK_NEAR(fs_eigen_principal_bound(axis, -INFINITY), 2.0, 1e-5);
+    const double bad[6] = {NAN, 0, 0, 0, 0, 0};
+    CHECK(!isfinite(fs_eigen_principal_bound(bad, 0.0)));
+}
+
 /* ---- rank ---- */
 
 static void test_rank_largest(void)
@@ -555,6 +597,7 @@ int main(void)
     RUN(test_eigen_prescribed);
     RUN(test_eigen_exact_cases);
     RUN(test_principal_stress);
+    RUN(test_principal_bound);
     RUN(test_rank_largest);
     RUN(test_rank_ties);
     RUN(test_event_quadratic);

@@ -140,6 +140,37 @@ int fs_eigen_principal_strain(const double strain[6], double eps[3], double dirs
     return fs_eigen_sym3(a, eps, dirs);
 }
 
+/* Relative margin added to the closed-form largest eigenvalue so that it bounds the exact one: the
+ * trigonometric formula loses up to about sqrt(machine epsilon) of the deviator's size when the
+ * eigenvalues nearly coincide. */
+#define CLOSED_FORM_MARGIN 1e-6
+
+/* design: cheap bounds first: the largest of the in-plane 2 x 2 block's eigenvalues and sigma_zz plus
+ * the Frobenius norm of the out-of-plane shears (Weyl's inequality; tight near a flat layer's free
+ * top), and the mean stress plus sqrt(2/3) times the deviator's Frobenius norm (any frame, so also on
+ * the sphere). Where both reach `level`, the closed-form (trigonometric) largest eigenvalue plus a
+ * safety margin: about a sixth of the cost of the Jacobi decomposition. */
+double fs_eigen_principal_bound(const double s[6], double level)
+{
+    double mean = 0.5 * (s[0] + s[1]), half = 0.5 * (s[0] - s[1]);
+    double in_plane = mean + sqrt(half * half + s[3] * s[3]);
+    double bound = fmax(in_plane, s[2]) + sqrt(2.0 * (s[4] * s[4] + s[5] * s[5]));
+    double q = (s[0] + s[1] + s[2]) / 3.0;
+    double d0 = s[0] - q, d1 = s[1] - q, d2 = s[2] - q;
+    double shear2 = s[3] * s[3] + s[4] * s[4] + s[5] * s[5];
+    double dev2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * shear2;
+    bound = fmin(bound, q + sqrt(2.0 * dev2 / 3.0));
+    bound += 1e-12 * (fabs(q) + sqrt(dev2)); /* the kernel's own rounding */
+    if (bound <= level || dev2 == 0.0)
+        return bound;
+    double p = sqrt(dev2 / 6.0);
+    double b0 = d0 / p, b1 = d1 / p, b2 = d2 / p, b3 = s[3] / p, b4 = s[4] / p, b5 = s[5] / p;
+    double det = b0 * (b1 * b2 - b4 * b4) - b3 * (b3 * b2 - b4 * b5) + b5 * (b3 * b4 - b1 * b5);
+    double r = fmin(1.0, fmax(-1.0, 0.5 * det));
+    double largest = q + 2.0 * p * cos(acos(r) / 3.0);
+    return fmin(bound, largest + CLOSED_FORM_MARGIN * (fabs(q) + 2.0 * p));
+}
+
 double fs_eigen_von_mises(const double s[6])
 {
     double dxy = s[0] - s[1], dyz = s[1] - s[2], dzx = s[2] - s[0];

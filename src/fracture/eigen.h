@@ -26,6 +26,12 @@ int fs_eigen_principal_stress(const double stress[6], double sigma[3], double di
  * (halved here to form the tensor). dirs as above. Returns 0 or -1. */
 int fs_eigen_principal_strain(const double strain[6], double eps[3], double dirs[9]);
 
+/* An upper bound of the largest principal stress (fs_eigen_principal_stress's sigma[0]) of a Voigt
+ * stress, tight (within a relative 1e-6 of the deviator's size) where it exceeds level; where it is
+ * at most level it may be loose. Never below the kernel's value, rounding included. Non-finite input
+ * gives a non-finite result. */
+double fs_eigen_principal_bound(const double s[6], double level);
+
 /* Von Mises equivalent stress of a Voigt stress (tensor shears):
  * sqrt(((sxx-syy)^2 + (syy-szz)^2 + (szz-sxx)^2) / 2 + 3 (txy^2 + tyz^2 + tzx^2)). */
 double fs_eigen_von_mises(const double stress[6]);

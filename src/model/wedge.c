@@ -983,38 +983,6 @@ static int refresh_cache(fs_wedge_model *w, const int32_t *elems, int32_t n)
 /* Relative allowance for rounding in a lazy ratio bound. */
 #define LAZY_MARGIN 1e-9
 
-/* Relative margin added to the closed-form largest eigenvalue so that it bounds the exact one: the
- * trigonometric formula loses up to about sqrt(machine epsilon) of the deviator's size when the
- * eigenvalues nearly coincide. */
-#define CLOSED_FORM_MARGIN 1e-6
-
-/* An upper bound of the largest eigenvalue of a symmetric stress (Voigt), tight where it reaches
- * `level`. Cheap bounds first: the largest of the in-plane 2 x 2 block's eigenvalues and sigma_zz
- * plus the Frobenius norm of the out-of-plane shears (Weyl's inequality; tight near a flat layer's
- * free top), and the mean stress plus sqrt(2/3) times the deviator's Frobenius norm (any frame, so
- * also on the sphere). Where both reach `level`, the closed-form (trigonometric) largest eigenvalue
- * plus a safety margin. */
-static double principal_bound(const double s[6], double level)
-{
-    double mean = 0.5 * (s[0] + s[1]), half = 0.5 * (s[0] - s[1]);
-    double in_plane = mean + sqrt(half * half + s[3] * s[3]);
-    double bound = fmax(in_plane, s[2]) + sqrt(2.0 * (s[4] * s[4] + s[5] * s[5]));
-    double q = (s[0] + s[1] + s[2]) / 3.0;
-    double d0 = s[0] - q, d1 = s[1] - q, d2 = s[2] - q;
-    double shear2 = s[3] * s[3] + s[4] * s[4] + s[5] * s[5];
-    double dev2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * shear2;
-    bound = fmin(bound, q + sqrt(2.0 * dev2 / 3.0));
-    bound += 1e-12 * (fabs(q) + sqrt(dev2)); /* the kernel's own rounding */
-    if (bound <= level || dev2 == 0.0)
-        return bound;
-    double p = sqrt(dev2 / 6.0);
-    double b0 = d0 / p, b1 = d1 / p, b2 = d2 / p, b3 = s[3] / p, b4 = s[4] / p, b5 = s[5] / p;
-    double det = b0 * (b1 * b2 - b4 * b4) - b3 * (b3 * b2 - b4 * b5) + b5 * (b3 * b4 - b1 * b5);
-    double r = fmin(1.0, fmax(-1.0, 0.5 * det));
-    double largest = q + 2.0 * p * cos(acos(r) / 3.0);
-    return fmin(bound, largest + CLOSED_FORM_MARGIN * (fabs(q) + 2.0 * p));
-}
-
 double fs_wedge_element_ratio(const fs_wedge_model *w, int32_t e)
 {
     if (w->state[e] != FS_WEDGE_ALIVE)
@@ -1045,9 +1013,9 @@ static int cmp_bound_desc(const void *a, const void *b)
  * resulting 9 values are sorted, and the largest one is compared against the material's threshold
  * stress"). Every fracture decision asks only whether the largest ratio exceeds 1 and which element
  * has it (fracture/rank.h, ties within FS_RANK_TIE_REL), so the shared eigen kernel runs only on the
- * elements whose upper bound (principal_bound) could reach the largest exact ratio, in descending order of the
- * bound, until the next bound falls below the best exact ratio found (less the tie tolerance). Every
- * other ratio holds its bound.
+ * elements whose upper bound (fs_eigen_principal_bound) could reach the largest exact ratio, in
+ * descending order of the bound, until the next bound falls below the best exact ratio found (less
+ * the tie tolerance). Every other ratio holds its bound.
  * With lazy_ratios, an element evaluated before at the same shrinkage and eigenstrain is not evaluated
  * again while its old bound plus ratio_lipschitz times the change of its nodal displacements stays at
  * most LAZY_LEVEL: that sum bounds the exact ratio too. After a removal the displacements change
@@ -1102,7 +1070,7 @@ static int element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_ele
                 for (int v = 0; v < 6; v++)
                     strain[v] -= w->shrink_coef[k] * c[54 + 18 * g + 6 * k + v];
             stress_of(w, e, strain, st + 6 * g);
-            bound = fmax(bound, principal_bound(st + 6 * g, w->threshold[e]));
+            bound = fmax(bound, fs_eigen_principal_bound(st + 6 * g, w->threshold[e]));
         }
         w->ratio[e] = bound / w->threshold[e];
         w->ratio_ref_bound[e] = w->ratio[e];
@@ -1188,7 +1156,9 @@ void fs_wedge_snapshot_take(const fs_wedge_model *w, fs_wedge_snapshot *s)
     }
     if (s->n_nodes != w->n_nodes || !s->node_ratio) {
         free(s->node_ratio);
+        free(s->node_ratio_exact);
         s->node_ratio = fs_malloc(((size_t)w->n_nodes + 1) * sizeof *s->node_ratio);
+        s->node_ratio_exact = fs_malloc((size_t)w->n_nodes + 1);
     }
     if (s->n_elems != w->n_elems || !s->stress_top) {
         free(s->stress_top);
@@ -1201,6 +1171,7 @@ void fs_wedge_snapshot_take(const fs_wedge_model *w, fs_wedge_snapshot *s)
     memcpy(s->x, w->x, (size_t)w->n_free * sizeof *s->x);
     memcpy(s->u_fixed, w->u_fixed, (size_t)w->n_fixed * sizeof *s->u_fixed);
     memcpy(s->node_ratio, w->node_ratio, (size_t)w->n_nodes * sizeof *s->node_ratio);
+    memcpy(s->node_ratio_exact, w->node_ratio_exact, (size_t)w->n_nodes);
     memcpy(s->stress_top, w->stress_top, 18 * (size_t)w->n_elems * sizeof *s->stress_top);
 }
 
@@ -1209,6 +1180,7 @@ void fs_wedge_snapshot_free(fs_wedge_snapshot *s)
     free(s->x);
     free(s->u_fixed);
     free(s->node_ratio);
+    free(s->node_ratio_exact);
     free(s->stress_top);
     memset(s, 0, sizeof *s);
 }
@@ -1321,8 +1293,11 @@ static void grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
     w->gauss_cache = fs_realloc(w->gauss_cache, GAUSS_CACHE * ne * sizeof *w->gauss_cache);
     w->edge_rest = fs_realloc(w->edge_rest, 3 * ne * sizeof *w->edge_rest);
     w->node_ratio = fs_realloc(w->node_ratio, nn * sizeof *w->node_ratio);
-    for (size_t i = (size_t)w->n_nodes; i < nn; i++)
+    w->node_ratio_exact = fs_realloc(w->node_ratio_exact, nn * sizeof *w->node_ratio_exact);
+    for (size_t i = (size_t)w->n_nodes; i < nn; i++) {
         w->node_ratio[i] = NAN;
+        w->node_ratio_exact[i] = 0;
+    }
     w->ratio_lipschitz = fs_realloc(w->ratio_lipschitz, ne * sizeof *w->ratio_lipschitz);
     w->ratio_ref_bound = fs_realloc(w->ratio_ref_bound, ne * sizeof *w->ratio_ref_bound);
     w->ratio_ref_u = fs_realloc(w->ratio_ref_u, 18 * ne * sizeof *w->ratio_ref_u);
@@ -1425,6 +1400,7 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->ratio);
     free(w->stress_top);
     free(w->node_ratio);
+    free(w->node_ratio_exact);
     free(w->residual);
     free(w->dirty_nodes);
     free(w->gauss_cache);

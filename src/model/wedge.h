@@ -150,9 +150,11 @@ typedef struct {
                                     could have reached 1 (wedge.c, element_ratios); set by
                                     fs_wedge_run for element removal, off by default */
     double *node_ratio;          /* per node: the nodal ratio of the split criterion at the current
-                                    stresses (wedge_split.c), NaN when it must be recomputed: set
+                                    stresses (wedge_split.c), or only an upper bound of it where
+                                    node_ratio_exact is 0; NaN when it must be recomputed: set
                                     NaN for the corners of every element whose stresses or
                                     neighbourhood change */
+    uint8_t *node_ratio_exact;   /* per node: 1 where node_ratio holds the ratio itself */
     double *ratio_lipschitz;     /* per element: bound of the change of its ratio per cm of change of
                                     its 18 nodal displacements (Euclidean norm) */
     double *ratio_ref_bound;     /* per element: its ratio bound at the last full evaluation (NaN:
@@ -267,6 +269,7 @@ typedef struct {
     int32_t n_free, n_fixed, n_nodes, n_elems;
     double *x, *u_fixed;
     double *node_ratio;          /* n_nodes: w->node_ratio (the split criterion's cache) */
+    uint8_t *node_ratio_exact;   /* n_nodes: w->node_ratio_exact */
     double *stress_top;          /* 18 per element: w->stress_top */
 } fs_wedge_snapshot;
 
@@ -381,7 +384,8 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed);
 
 /* The largest nodal ratio among the split candidates at the current equilibrium (tips, their coarse
  * estimate times tip_scale, and nodes off every crack and boundary), -inf if none: what the split
- * method's event search looks at. Fills the nodal ratio cache of every candidate. */
+ * method's event search looks at. Fills the nodal ratio cache of every candidate with its ratio, or
+ * with an upper bound of it where the bound shows it is not the largest. */
 double fs_wedge_split_max_ratio(fs_wedge_model *w);
 
 /* fs_wedge_split_max_ratio of the state at time t blended between the snapshots a and b (taken right

@@ -129,13 +129,15 @@ static double tip_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t 
     return best;
 }
 
-/* Nodal ratio of node i (thesis §5.7.1), and the fracture plane normal (3-D, unit) if m is not NULL.
- * The top Gauss point nearest corner c is top point c (wedge_element.h), whose stress the last
- * equilibrium left in stress_top. -inf for a node without a living element. */
-static double node_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t i, double m[3])
+/* The mean of the stresses at the top Gauss points nearest node i over its living elements (top point
+ * c is the one nearest corner c, wedge_element.h) and the mean of their thresholds; false for a node
+ * without a living element. */
+static bool node_mean_stress(const fs_wedge_model *w, const stresses *st, int32_t i, double s[6], double *thr)
 {
-    double s[6] = {0}, thr = 0.0;
+    double sum = 0.0;
     int count = 0;
+    for (int k = 0; k < 6; k++)
+        s[k] = 0.0;
     for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++) {
         int32_t e = w->node_elem[p];
         if (w->state[e] != FS_WEDGE_ALIVE)
@@ -145,13 +147,25 @@ static double node_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t
         stress_at(st, e, c, v);
         for (int k = 0; k < 6; k++)
             s[k] += v[k];
-        thr += w->threshold[e];
+        sum += w->threshold[e];
         count++;
     }
     if (count == 0)
-        return -INFINITY;
+        return false;
     for (int k = 0; k < 6; k++)
         s[k] /= count;
+    *thr = sum / count;
+    return true;
+}
+
+/* Nodal ratio of node i (thesis §5.7.1), and the fracture plane normal (3-D, unit) if m is not NULL.
+ * The stresses are those the last equilibrium left in stress_top (or a blend, st). -inf for a node
+ * without a living element or with a non-finite stress. */
+static double node_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t i, double m[3])
+{
+    double s[6], thr;
+    if (!node_mean_stress(w, st, i, s, &thr))
+        return -INFINITY;
     double sigma[3], dirs[9];
     if (fs_eigen_principal_stress(s, sigma, m ? dirs : NULL) < 0) {
         fs_error_clear();
@@ -159,7 +173,21 @@ static double node_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t
     }
     if (m)
         memcpy(m, dirs, 3 * sizeof *m);
-    return sigma[0] / (thr / count);
+    return sigma[0] / thr;
+}
+
+/* An upper bound of node_ratio_of(w, st, i, NULL), tight where it exceeds level (see
+ * fs_eigen_principal_bound; the division by the same positive mean threshold keeps the order). NaN
+ * where only the exact ratio will do: a stress that is not finite, a threshold that is not positive. */
+static double node_bound_of(const fs_wedge_model *w, const stresses *st, int32_t i, double level)
+{
+    double s[6], thr;
+    if (!node_mean_stress(w, st, i, s, &thr))
+        return -INFINITY;
+    if (!(thr > 0.0))
+        return NAN;
+    double b = fs_eigen_principal_bound(s, level * thr) / thr;
+    return isfinite(b) ? b : NAN;
 }
 
 static double tip_ratio(const fs_wedge_model *w, int32_t i, double m[3])
@@ -174,12 +202,28 @@ static double node_ratio(const fs_wedge_model *w, int32_t i, double m[3])
     return node_ratio_of(w, &st, i, m);
 }
 
-/* node_ratio without the direction, from the cache w->node_ratio where it is valid. */
+/* node_ratio without the direction, from the cache w->node_ratio where it holds the exact value. */
 static double cached_node_ratio(fs_wedge_model *w, int32_t i)
 {
-    if (isnan(w->node_ratio[i])) {
+    if (isnan(w->node_ratio[i]) || !w->node_ratio_exact[i]) {
         double r = node_ratio(w, i, NULL);
         w->node_ratio[i] = isnan(r) ? -INFINITY : r;
+        w->node_ratio_exact[i] = 1;
+    }
+    return w->node_ratio[i];
+}
+
+/* An upper bound of node i's ratio from the cache (exact or a bound), else computed and cached, tight
+ * where it exceeds level. NaN if only the exact ratio will do (node_bound_of). */
+static double cached_node_bound(fs_wedge_model *w, int32_t i, double level)
+{
+    if (isnan(w->node_ratio[i])) {
+        const stresses st = {w->stress_top, NULL, 0.0};
+        double b = node_bound_of(w, &st, i, level);
+        if (isnan(b))
+            return NAN;
+        w->node_ratio[i] = b;
+        w->node_ratio_exact[i] = 0;
     }
     return w->node_ratio[i];
 }
@@ -203,6 +247,11 @@ static const uint8_t *open_nodes(fs_wedge_model *w)
     return w->open;
 }
 
+/* design: the nodal ratios are wanted only where they could be the largest (the event search) or over
+ * 1 (the pick of an event), so the Jacobi decomposition runs only where a cheap bound (about a sixth
+ * of its cost, fs_eigen_principal_bound) does not settle the question; the cache keeps the bound, and
+ * a blend between snapshots turns a bound into the exact ratio at that snapshot only where its answer
+ * depends on it. Every answer is the one the exact ratios everywhere would give, bit for bit. */
 double fs_wedge_split_max_ratio(fs_wedge_model *w)
 {
     double best = -INFINITY;
@@ -210,9 +259,29 @@ double fs_wedge_split_max_ratio(fs_wedge_model *w)
         best = fmax(best, tip_ratio(w, w->tip_node[k], NULL) * w->tip_scale[k]);
     const uint8_t *open = open_nodes(w);
     for (int32_t i = 0; i < w->n_nodes; i++)
-        if (!open[i])
+        if (!open[i] && w->node_ratio_exact[i] && !isnan(w->node_ratio[i]))
+            best = fmax(best, w->node_ratio[i]);
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        if (!open[i] && !(cached_node_bound(w, i, best) <= best))
             best = fmax(best, cached_node_ratio(w, i));
     return best;
+}
+
+/* Node i's ratio in snapshot s: exact, or NaN if s holds only a bound (*bound receives the upper
+ * bound either way: the exact ratio, the cached bound, or NaN where nothing is known). */
+static double snapshot_ratio(const fs_wedge_snapshot *s, int32_t i, double *bound)
+{
+    *bound = s->node_ratio[i];
+    return s->node_ratio_exact[i] ? s->node_ratio[i] : NAN;
+}
+
+/* The exact ratio of node i in snapshot s (its stresses; same mesh as w), as cached_node_ratio would
+ * have cached it. */
+static double snapshot_exact_ratio(const fs_wedge_model *w, const fs_wedge_snapshot *s, int32_t i)
+{
+    const stresses st = {s->stress_top, NULL, 0.0};
+    double r = node_ratio_of(w, &st, i, NULL);
+    return isnan(r) ? -INFINITY : r;
 }
 
 double fs_wedge_split_blend_ratio(fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b,
@@ -226,15 +295,39 @@ double fs_wedge_split_blend_ratio(fs_wedge_model *w, const fs_wedge_snapshot *a,
     for (int32_t k = 0; k < w->n_tips; k++)
         best = fmax(best, tip_ratio_of(w, &st, w->tip_node[k], NULL) * w->tip_scale[k]);
     const uint8_t *open = open_nodes(w);
+    /* nodes whose end ratios are only known to be at most 1, with that bound: they can only raise
+     * `bound`, which matters only if nothing is over 1 */
+    int32_t *later = fs_malloc(((size_t)w->n_nodes + 1) * sizeof *later), n_later = 0;
     for (int32_t i = 0; i < w->n_nodes; i++) {
         if (open[i])
             continue;
-        double end = fmax(a->node_ratio[i], b->node_ratio[i]); /* NaN-free: the cache was filled */
+        double ua, ub, ra = snapshot_ratio(a, i, &ua), rb = snapshot_ratio(b, i, &ub);
+        if (isnan(ra) || isnan(rb)) {
+            if (fmax(ua, ub) <= 1.0 && !isnan(ua) && !isnan(ub)) {
+                later[n_later++] = i;
+                continue;
+            }
+            ra = isnan(ra) ? snapshot_exact_ratio(w, a, i) : ra;
+            rb = isnan(rb) ? snapshot_exact_ratio(w, b, i) : rb;
+        }
+        double end = fmax(ra, rb);
         if (end > 1.0)
             best = fmax(best, node_ratio_of(w, &st, i, NULL));
         else
             bound = fmax(bound, end);
     }
+    if (!(best > 1.0)) {
+        for (int32_t q = 0; q < n_later; q++) {
+            int32_t i = later[q];
+            double ua, ub, ra = snapshot_ratio(a, i, &ua), rb = snapshot_ratio(b, i, &ub);
+            if (fmax(ua, ub) <= bound)
+                continue;
+            ra = isnan(ra) ? snapshot_exact_ratio(w, a, i) : ra;
+            rb = isnan(rb) ? snapshot_exact_ratio(w, b, i) : rb;
+            bound = fmax(bound, fmax(ra, rb));
+        }
+    }
+    free(later);
     return best > 1.0 ? best : fmax(best, bound);
 }
 
@@ -877,7 +970,7 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed)
         const uint8_t *open = open_nodes(w);
         double *r = fs_malloc(((size_t)w->n_nodes + 1) * sizeof *r);
         for (int32_t i = 0; i < w->n_nodes; i++) {
-            r[i] = open[i] ? NAN : cached_node_ratio(w, i);
+            r[i] = open[i] || cached_node_bound(w, i, 1.0) <= 1.0 ? NAN : cached_node_ratio(w, i);
             if (!(r[i] > 1.0))
                 r[i] = NAN;
         }
