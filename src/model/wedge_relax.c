@@ -88,15 +88,24 @@ static double residual(fs_wedge_model *w, double *r)
     return sqrt(b2);
 }
 
-/* The largest |v[i]| (NaN entries are passed over, as fmax does). */
+/* The largest |v[i]| (NaN entries are passed over, as fmax does), in four interleaved running maxima:
+ * each comparison of one running maximum would wait on the one before. */
 static double norm_max(const double *v, int32_t n)
 {
-    double s = 0.0;
-    for (int32_t i = 0; i < n; i++) {
+    double m[4] = {0.0, 0.0, 0.0, 0.0};
+    int32_t i = 0;
+    for (; i + 4 <= n; i += 4)
+        for (int k = 0; k < 4; k++) {
+            double a = fabs(v[i + k]);
+            m[k] = a > m[k] ? a : m[k];
+        }
+    for (; i < n; i++) {
         double a = fabs(v[i]);
-        if (a > s)
-            s = a;
+        m[0] = a > m[0] ? a : m[0];
     }
+    double s = m[0];
+    for (int k = 1; k < 4; k++)
+        s = m[k] > s ? m[k] : s;
     return s;
 }
 
