@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "base/error.h"
+#include "base/sort.h"
 #include "base/vec.h"
 
 /* State of one fs_refine_bisect call. The mesh arrays hold cap_* entries during the call (see
@@ -695,12 +696,6 @@ void fs_refine_change_free(fs_refine_change *change)
 
 static void *trimmed(void *p, size_t n, size_t size) { return fs_realloc(p, (n ? n : 1) * size); }
 
-static int cmp_int32(const void *pa, const void *pb)
-{
-    int32_t a = *(const int32_t *)pa, b = *(const int32_t *)pb;
-    return (a > b) - (a < b);
-}
-
 int fs_refine_bisect(fs_mesh *m, const int32_t *tris, int32_t n_tris, double min_size, fs_refine_change *change)
 {
     if (validate(m, tris, n_tris, min_size) != 0)
@@ -767,7 +762,7 @@ int fs_refine_bisect(fs_mesh *m, const int32_t *tris, int32_t n_tris, double min
         change->n_new_tris = new_tris;
         change->tri_parent = trimmed(r.tri_parent, (size_t)new_tris, sizeof *r.tri_parent);
         if (r.n_split > 1)
-            qsort(r.split_list, (size_t)r.n_split, sizeof *r.split_list, cmp_int32);
+            fs_sort_int32(r.split_list, r.n_split);
         change->changed_tri = trimmed(r.split_list, (size_t)r.n_split, sizeof *r.split_list);
         change->n_changed_tris = r.n_split;
         change->n_bisections = r.n_bisections;

@@ -8,6 +8,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "base/rng.h"
+#include "base/sort.h"
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "fracture/rank.h"
@@ -270,12 +271,6 @@ static int32_t node_elem_take(fs_wedge_model *w, int32_t room)
     return start;
 }
 
-static int cmp_int32(const void *a, const void *b)
-{
-    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
-    return (x > y) - (x < y);
-}
-
 int32_t fs_wedge_elems_at(const fs_wedge_model *w, int32_t i, const int32_t *changed, int32_t n_changed,
                           int32_t first_new, bool living, int32_t *out)
 {
@@ -288,8 +283,7 @@ int32_t fs_wedge_elems_at(const fs_wedge_model *w, int32_t i, const int32_t *cha
         out[n++] = changed[q];
     for (int32_t t = first_new; t < m->n_tris; t++)
         out[n++] = t;
-    if (n > 1)
-        qsort(out, (size_t)n, sizeof *out, cmp_int32);
+    fs_sort_int32(out, n);
     int32_t kept = 0;
     for (int32_t q = 0; q < n; q++) {
         int32_t t = out[q];
@@ -331,12 +325,9 @@ static void update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const i
             touch[n_touch++] = m->tri[3 * (size_t)e + k];
     for (int32_t q = 0; q < nl; q++)
         touch[n_touch++] = lost[q];
-    if (n_touch > 1)
-        qsort(touch, (size_t)n_touch, sizeof *touch, cmp_int32);
+    n_touch = fs_sort_unique_int32(touch, n_touch);
     for (int32_t t = 0; t < n_touch; t++) {
         int32_t i = touch[t];
-        if (t > 0 && touch[t - 1] == i)
-            continue;
         int32_t start = w->node_elem_start[i], count = w->node_elem_count[i];
         if (count + n_changed + n_new_elems > cap_cand) {
             cap_cand = count + n_changed + n_new_elems;
@@ -1482,11 +1473,7 @@ static int update_region(fs_wedge_model *w, const int32_t *nodes, int32_t n)
             if (w->state[w->node_elem[p]] == FS_WEDGE_ALIVE)
                 elems[ne++] = w->node_elem[p];
     }
-    qsort(elems, (size_t)ne, sizeof *elems, cmp_int32);
-    int32_t unique = 0;
-    for (int32_t q = 0; q < ne; q++)
-        if (unique == 0 || elems[unique - 1] != elems[q])
-            elems[unique++] = elems[q];
+    int32_t unique = fs_sort_unique_int32(elems, ne);
     int rc = readd(w, elems, unique, w->mark);
     for (int32_t q = 0; q < n; q++) {
         int32_t i = nodes[q];

@@ -5,6 +5,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "base/sort.h"
 #include "model/wedge.h"
 #include "solve/cg.h"
 #include "solve/sparse.h"
@@ -195,24 +196,12 @@ int32_t fs_wedge_relax_region(const fs_wedge_model *w, const int32_t *seeds, int
     return count;
 }
 
-static int cmp_int32(const void *a, const void *b)
-{
-    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
-    return (x > y) - (x < y);
-}
-
 /* Sorts v (n values in 0 .. range - 1) ascending without repeats; returns the new count. A large list
  * is sorted by marking and scanning its range, a short one by comparisons. */
 static int32_t sort_unique(int32_t *v, int32_t n, int32_t range)
 {
-    if ((int64_t)n * 16 < range) {
-        qsort(v, (size_t)n, sizeof *v, cmp_int32);
-        int32_t m = 0;
-        for (int32_t q = 0; q < n; q++)
-            if (m == 0 || v[m - 1] != v[q])
-                v[m++] = v[q];
-        return m;
-    }
+    if ((int64_t)n * 16 < range)
+        return fs_sort_unique_int32(v, n);
     uint8_t *seen = fs_calloc((size_t)range + 1, 1);
     for (int32_t q = 0; q < n; q++)
         seen[v[q]] = 1;

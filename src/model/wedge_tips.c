@@ -5,6 +5,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "base/sort.h"
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "geom/refine.h"
@@ -16,12 +17,6 @@
 #define SUBMODEL_PASSES 40
 /* Step lengths a smoothing move tries, as fractions of the angle-based target's displacement. */
 static const double smooth_steps[] = {1.0, 0.5, 0.25};
-
-static int cmp_int32(const void *a, const void *b)
-{
-    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
-    return (x > y) - (x < y);
-}
 
 double fs_wedge_tips_unit(fs_wedge_model *w)
 {
@@ -176,7 +171,7 @@ static int32_t tip_vicinity(const fs_mesh *m, int32_t tip, double size, uint8_t 
         if (fs_refine_tri_size(m, out[q]) >= size)
             out[kept++] = out[q];
     }
-    qsort(out, (size_t)kept, sizeof *out, cmp_int32);
+    fs_sort_int32(out, kept);
     return kept;
 }
 
@@ -225,7 +220,7 @@ int fs_wedge_tip_submodel(fs_wedge_model *w, int32_t node, double radius, double
     }
     free(taken);
     free(region);
-    qsort(elems, (size_t)n_e, sizeof *elems, cmp_int32);
+    fs_sort_int32(elems, n_e);
     inf.extracted_elems = n_e;
 
     /* 2. the copy: nodes in order of first use, and per node and per element what the model needs */
@@ -552,7 +547,7 @@ int fs_wedge_smooth(fs_wedge_model *w, const int32_t *centres, int32_t n, double
         if (!skip[region[q]] && !w->pinned[region[q]])
             region[n_cand++] = region[q];
     free(skip);
-    qsort(region, (size_t)n_cand, sizeof *region, cmp_int32);
+    fs_sort_int32(region, n_cand);
     uint8_t *was_moved = fs_calloc((size_t)w->n_nodes + 1, 1);
     fan_t fan = {0};
     for (int it = 0; it < iterations; it++) {
