@@ -267,21 +267,28 @@ double fs_wedge_split_max_ratio(fs_wedge_model *w)
     return best;
 }
 
-/* Node i's ratio in snapshot s: exact, or NaN if s holds only a bound (*bound receives the upper
- * bound either way: the exact ratio, the cached bound, or NaN where nothing is known). */
-static double snapshot_ratio(const fs_wedge_snapshot *s, int32_t i, double *bound)
+/* The exact ratio of node i in snapshot s (same mesh as w), as cached_node_ratio would have cached
+ * it: from the snapshot's cache where that holds it, else from the snapshot's stresses. */
+static double snapshot_ratio(const fs_wedge_model *w, const fs_wedge_snapshot *s, int32_t i)
 {
-    *bound = s->node_ratio[i];
-    return s->node_ratio_exact[i] ? s->node_ratio[i] : NAN;
-}
-
-/* The exact ratio of node i in snapshot s (its stresses; same mesh as w), as cached_node_ratio would
- * have cached it. */
-static double snapshot_exact_ratio(const fs_wedge_model *w, const fs_wedge_snapshot *s, int32_t i)
-{
+    if (s->node_ratio_exact[i] && !isnan(s->node_ratio[i]))
+        return s->node_ratio[i];
     const stresses st = {s->stress_top, NULL, 0.0};
     double r = node_ratio_of(w, &st, i, NULL);
     return isnan(r) ? -INFINITY : r;
+}
+
+/* The larger of node i's exact ratios in a and b. */
+static double end_ratio(const fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b, int32_t i)
+{
+    return fmax(snapshot_ratio(w, a, i), snapshot_ratio(w, b, i));
+}
+
+/* An upper bound of end_ratio from the snapshots' caches, NaN where either holds nothing. */
+static double end_bound(const fs_wedge_snapshot *a, const fs_wedge_snapshot *b, int32_t i)
+{
+    double ua = a->node_ratio[i], ub = b->node_ratio[i];
+    return isnan(ua) || isnan(ub) ? NAN : fmax(ua, ub);
 }
 
 double fs_wedge_split_blend_ratio(fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b,
@@ -295,38 +302,25 @@ double fs_wedge_split_blend_ratio(fs_wedge_model *w, const fs_wedge_snapshot *a,
     for (int32_t k = 0; k < w->n_tips; k++)
         best = fmax(best, tip_ratio_of(w, &st, w->tip_node[k], NULL) * w->tip_scale[k]);
     const uint8_t *open = open_nodes(w);
-    /* nodes whose end ratios are only known to be at most 1, with that bound: they can only raise
-     * `bound`, which matters only if nothing is over 1 */
+    /* nodes whose end ratios are at most 1 by their bounds: they can only raise `bound`, which
+     * matters only if nothing is over 1 */
     int32_t *later = fs_malloc(((size_t)w->n_nodes + 1) * sizeof *later), n_later = 0;
     for (int32_t i = 0; i < w->n_nodes; i++) {
         if (open[i])
             continue;
-        double ua, ub, ra = snapshot_ratio(a, i, &ua), rb = snapshot_ratio(b, i, &ub);
-        if (isnan(ra) || isnan(rb)) {
-            if (fmax(ua, ub) <= 1.0 && !isnan(ua) && !isnan(ub)) {
-                later[n_later++] = i;
-                continue;
-            }
-            ra = isnan(ra) ? snapshot_exact_ratio(w, a, i) : ra;
-            rb = isnan(rb) ? snapshot_exact_ratio(w, b, i) : rb;
+        if (end_bound(a, b, i) <= 1.0) {
+            later[n_later++] = i;
+            continue;
         }
-        double end = fmax(ra, rb);
+        double end = end_ratio(w, a, b, i);
         if (end > 1.0)
             best = fmax(best, node_ratio_of(w, &st, i, NULL));
         else
             bound = fmax(bound, end);
     }
-    if (!(best > 1.0)) {
-        for (int32_t q = 0; q < n_later; q++) {
-            int32_t i = later[q];
-            double ua, ub, ra = snapshot_ratio(a, i, &ua), rb = snapshot_ratio(b, i, &ub);
-            if (fmax(ua, ub) <= bound)
-                continue;
-            ra = isnan(ra) ? snapshot_exact_ratio(w, a, i) : ra;
-            rb = isnan(rb) ? snapshot_exact_ratio(w, b, i) : rb;
-            bound = fmax(bound, fmax(ra, rb));
-        }
-    }
+    for (int32_t q = 0; q < n_later && !(best > 1.0); q++)
+        if (end_bound(a, b, later[q]) > bound)
+            bound = fmax(bound, end_ratio(w, a, b, later[q]));
     free(later);
     return best > 1.0 ? best : fmax(best, bound);
 }
