@@ -7,7 +7,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "geom/domain.h"
-#include "io/image.h"
+#include "image/image.h"
 #include "io/preset.h"
 #include "render/crackgraph.h"
 #include "render/occlusion.h"

@@ -49,7 +49,7 @@ int main(int argc, char **argv)
 
     double t0 = fs_seconds();
     fs_lifted_mesh l;
-    if (fs_render_mesh_lift(&res.surface, &d, 1.0, &l) < 0)
+    if (fs_render_lift(&res.surface, &d, 1.0, &l) < 0)
         return fail();
     double t1 = fs_seconds();
     char tmp[] = "/tmp/fissure-bench-XXXXXX";

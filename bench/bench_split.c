@@ -11,7 +11,7 @@
 #include "geom/delaunay.h"
 #include "geom/sample.h"
 #include "io/preset.h"
-#include "model/wedge.h"
+#include "model/wedge/wedge.h"
 
 /* CPU seconds of the process (all threads): the machine running a benchmark may be shared. */
 static double cpu_seconds(void)

@@ -11,7 +11,7 @@
 #include "base/vec.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
-#include "model/springs.h"
+#include "model/springs/springs.h"
 
 /* Mean spacing of the masses (cm): the tile grows with N so that the physics per mass stays that of
  * presets/mud-springs.ini (3000 masses on a 10 cm tile). */
@@ -95,7 +95,7 @@ int main(int argc, char **argv)
     st.seed = 1;
 
     fs_springs s;
-    fs_render_mesh r = {0};
+    fs_surface r = {0};
     int rc = fs_springs_init(&s, &m, &st);
     if (rc == 0)
         rc = fs_springs_advance(&s, st.time_end);
@@ -112,7 +112,7 @@ int main(int argc, char **argv)
            n, side, t1 - t0, t2 - t1, (int)s.break_count, s.time,
            s.break_count ? 1e3 * (t2 - t1) / s.break_count : 0.0, (long long)s.evaluations, (long long)s.net.solves,
            (long long)s.net.factorizations, t3 - t2, (int)r.n_tris, t3 - t0);
-    fs_render_mesh_free(&r);
+    fs_surface_free(&r);
     fs_springs_free(&s);
     fs_mesh_free(&m);
     return 0;

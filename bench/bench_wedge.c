@@ -13,7 +13,7 @@
 #include "geom/delaunay.h"
 #include "geom/mesh.h"
 #include "geom/sample.h"
-#include "model/wedge.h"
+#include "model/wedge/wedge.h"
 #include "solve/cg.h"
 #include "solve/sparse.h"
 

@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "base/error.h"
-#include "io/image.h"
+#include "image/image.h"
 
 /* A crack pixel: at least half white in the anti-aliased mask. */
 #define CRACK 0.5f

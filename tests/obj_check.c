@@ -25,7 +25,7 @@
  *    outwards (away from the plane's underside, the cylinder's axis, the sphere's centre), unless
  *    "leaning" is given: for the springs model's relaxed cells, whose own walls can lean over their
  *    bases and whose tops can cross themselves where the post-process pushed a corner over a side
- *    (model/springs_post.c), the facing of "layer" triangles is not checked (everything else is). */
+ *    (model/springs/post.c), the facing of "layer" triangles is not checked (everything else is). */
 
 #define PI 3.14159265358979323846
 

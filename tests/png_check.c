@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "base/error.h"
-#include "io/image.h"
+#include "image/image.h"
 
 static uint32_t be32(const unsigned char *p)
 {

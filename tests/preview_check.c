@@ -4,7 +4,7 @@
 #include <stdlib.h>
 
 #include "base/error.h"
-#include "io/image.h"
+#include "image/image.h"
 
 /* Usage: preview_check FILE
  * The object is every pixel that differs from the backdrop, a smooth vertical gradient: from the

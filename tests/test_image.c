@@ -1,5 +1,5 @@
-/* Tests of image I/O, comparison, distance transform and downsampling (io/image.h). */
-#include "io/image.h"
+/* Tests of image I/O, comparison, distance transform and downsampling (image/image.h). */
+#include "image/image.h"
 
 #include <math.h>
 #include <stdlib.h>

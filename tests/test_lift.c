@@ -13,14 +13,14 @@
 #include "io/obj.h"
 
 /* An axis-aligned quad [u0,u1] x [v0,v1] at one height, with vertices of its own. */
-static void add_quad(fs_render_mesh *m, double u0, double v0, double u1, double v1, double height)
+static void add_quad(fs_surface *m, double u0, double v0, double u1, double v1, double height)
 {
-    int32_t a = fs_render_mesh_add_vertex(m, u0, v0, height, 0.0, 1.0, 0.0);
-    int32_t b = fs_render_mesh_add_vertex(m, u1, v0, height, 0.0, 1.0, 0.0);
-    int32_t c = fs_render_mesh_add_vertex(m, u1, v1, height, 0.0, 1.0, 0.0);
-    int32_t d = fs_render_mesh_add_vertex(m, u0, v1, height, 0.0, 1.0, 0.0);
-    fs_render_mesh_add_tri(m, a, b, c);
-    fs_render_mesh_add_tri(m, a, c, d);
+    int32_t a = fs_surface_add_vertex(m, u0, v0, height, 0.0, 1.0, 0.0);
+    int32_t b = fs_surface_add_vertex(m, u1, v0, height, 0.0, 1.0, 0.0);
+    int32_t c = fs_surface_add_vertex(m, u1, v1, height, 0.0, 1.0, 0.0);
+    int32_t d = fs_surface_add_vertex(m, u0, v1, height, 0.0, 1.0, 0.0);
+    fs_surface_add_tri(m, a, b, c);
+    fs_surface_add_tri(m, a, c, d);
 }
 
 /* V - E + F over the positions, edges and triangles of l. */
@@ -48,12 +48,12 @@ static int32_t count_walls(const fs_lifted_mesh *l)
  * bounded only by the domain's border. */
 static void plane_step(void)
 {
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     add_quad(&m, 0.0, 0.0, 0.5, 1.0, 0.2);
     add_quad(&m, 0.5, 0.0, 1.0, 1.0, 0.0);
     fs_domain d = fs_domain_default();
     fs_lifted_mesh l;
-    CHECK(fs_render_mesh_lift(&m, &d, 1.0, &l) == 0);
+    CHECK(fs_render_lift(&m, &d, 1.0, &l) == 0);
     CHECK(l.n_pos == 8);
     CHECK(l.n_tris == 6);
     CHECK(count_walls(&l) == 2);
@@ -87,7 +87,7 @@ static void plane_step(void)
     free(edges);
     CHECK(euler(&l) == 1);
     fs_lifted_mesh_free(&l);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 /* A band of eight quads around a cylinder (radius 1, height 2) at 0.1 cm, starting before the seam
@@ -96,7 +96,7 @@ static void plane_step(void)
  * only at its two ends, every position at radius 1.1. */
 static void cylinder_seam(void)
 {
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     for (int k = 0; k < 8; k++)
         add_quad(&m, -0.05 + k / 8.0, 0.0, -0.05 + (k + 1) / 8.0, 1.0, 0.1);
     fs_domain d = fs_domain_default();
@@ -105,7 +105,7 @@ static void cylinder_seam(void)
     d.height = 2.0;
     fs_domain_normalize(&d);
     fs_lifted_mesh l;
-    CHECK(fs_render_mesh_lift(&m, &d, 1.0, &l) == 0);
+    CHECK(fs_render_lift(&m, &d, 1.0, &l) == 0);
     /* two rows of the quads' eight edge columns and of the seam, and the seam's cut of the
      * straddling quad's diagonal */
     CHECK_MSG(l.n_pos == 19, "%d positions", (int)l.n_pos);
@@ -137,7 +137,7 @@ static void cylinder_seam(void)
         CHECK(fs_dot3(n, mid) > 0.0);
     }
     fs_lifted_mesh_free(&l);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 /* A latitude-longitude grid over a sphere of radius 2 (u in eighths, v in quarters, at 0.05 cm):
@@ -146,7 +146,7 @@ static void cylinder_seam(void)
  * positions. */
 static void sphere_closed(void)
 {
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     for (int j = 0; j < 4; j++)
         for (int k = 0; k < 8; k++)
             add_quad(&m, k / 8.0, j / 4.0, (k + 1) / 8.0, (j + 1) / 4.0, 0.05);
@@ -155,7 +155,7 @@ static void sphere_closed(void)
     d.radius = 2.0;
     fs_domain_normalize(&d);
     fs_lifted_mesh l;
-    CHECK(fs_render_mesh_lift(&m, &d, 1.0, &l) == 0);
+    CHECK(fs_render_lift(&m, &d, 1.0, &l) == 0);
     CHECK(l.n_pos == 26);
     int32_t *edges;
     CHECK(fs_lifted_mesh_boundary(&l, &edges, NULL) == 0);
@@ -164,7 +164,7 @@ static void sphere_closed(void)
     for (int32_t i = 0; i < l.n_pos; i++)
         CHECK_NEAR(fs_norm3(l.pos + 3 * i), 2.05, 1e-7);
     fs_lifted_mesh_free(&l);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 /* Coincident triangles bound nothing: two copies cancel, a third copy stays. */
@@ -172,21 +172,21 @@ static void coincident_cancel(void)
 {
     fs_domain d = fs_domain_default();
     for (int copies = 1; copies <= 3; copies++) {
-        fs_render_mesh m = {0};
+        fs_surface m = {0};
         for (int c = 0; c < copies; c++) {
-            int32_t a = fs_render_mesh_add_vertex(&m, 0.1, 0.1, 0.0, 0.0, 1.0, 0.0);
-            int32_t b = fs_render_mesh_add_vertex(&m, 0.6, 0.1, 0.0, 0.0, 1.0, 0.0);
-            int32_t e = fs_render_mesh_add_vertex(&m, 0.3, 0.5, 0.0, 0.0, 1.0, 0.0);
+            int32_t a = fs_surface_add_vertex(&m, 0.1, 0.1, 0.0, 0.0, 1.0, 0.0);
+            int32_t b = fs_surface_add_vertex(&m, 0.6, 0.1, 0.0, 0.0, 1.0, 0.0);
+            int32_t e = fs_surface_add_vertex(&m, 0.3, 0.5, 0.0, 0.0, 1.0, 0.0);
             if (c == 1)
-                fs_render_mesh_add_tri(&m, a, e, b); /* the opposite way round */
+                fs_surface_add_tri(&m, a, e, b); /* the opposite way round */
             else
-                fs_render_mesh_add_tri(&m, a, b, e);
+                fs_surface_add_tri(&m, a, b, e);
         }
         fs_lifted_mesh l;
-        CHECK(fs_render_mesh_lift(&m, &d, 1.0, &l) == 0);
+        CHECK(fs_render_lift(&m, &d, 1.0, &l) == 0);
         CHECK(l.n_tris == copies % 2);
         fs_lifted_mesh_free(&l);
-        fs_render_mesh_free(&m);
+        fs_surface_free(&m);
     }
 }
 
@@ -196,14 +196,14 @@ static void coincident_cancel(void)
  * keeps two triangles, and the whole stays a disk. */
 static void uneven_steps(void)
 {
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     add_quad(&m, 0.0, 0.0, 0.5, 0.5, 0.0);  /* floor, in two quads that meet the tops' corners */
     add_quad(&m, 0.0, 0.5, 0.5, 1.0, 0.0);
     add_quad(&m, 0.5, 0.0, 1.0, 0.5, 0.3);  /* lower top */
     add_quad(&m, 0.5, 0.5, 1.0, 1.0, 0.31); /* higher top */
     fs_domain d = fs_domain_default();
     fs_lifted_mesh l;
-    CHECK(fs_render_mesh_lift(&m, &d, 1.0, &l) == 0);
+    CHECK(fs_render_lift(&m, &d, 1.0, &l) == 0);
     int32_t *edges;
     int32_t n_b = fs_lifted_mesh_boundary(&l, &edges, NULL);
     CHECK(n_b > 0);
@@ -217,7 +217,7 @@ static void uneven_steps(void)
     free(edges);
     CHECK(euler(&l) == 1);
     fs_lifted_mesh_free(&l);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 /* Two raised cells touching only at the centre of the plane, across two crack floors (a checkerboard
@@ -227,14 +227,14 @@ static void uneven_steps(void)
  * ways, and the two cells share no position above the floor. */
 static void touching_corners(void)
 {
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     add_quad(&m, 0.0, 0.0, 0.5, 0.5, 0.2);
     add_quad(&m, 0.5, 0.5, 1.0, 1.0, 0.2);
     add_quad(&m, 0.5, 0.0, 1.0, 0.5, 0.0);
     add_quad(&m, 0.0, 0.5, 0.5, 1.0, 0.0);
     fs_domain d = fs_domain_default();
     fs_lifted_mesh l;
-    CHECK(fs_render_mesh_lift(&m, &d, 1.0, &l) == 0);
+    CHECK(fs_render_lift(&m, &d, 1.0, &l) == 0);
     int32_t *edges, bad = -1;
     fs_lifted_mesh_boundary(&l, &edges, &bad);
     free(edges);
@@ -269,19 +269,19 @@ static void touching_corners(void)
     }
     CHECK_MSG(shared == 0, "the two cells' tops share %d corners", (int)shared);
     fs_lifted_mesh_free(&l);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 /* The OBJ file holds exactly the lifted mesh: as many v, vt, vn and f lines as positions, texture
  * vertices, normals and triangles, walls in their own group, and the same bytes for the same mesh. */
 static void obj_file(void)
 {
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     add_quad(&m, 0.0, 0.0, 0.5, 1.0, 0.2);
     add_quad(&m, 0.5, 0.0, 1.0, 1.0, 0.0);
     fs_domain d = fs_domain_default();
     fs_lifted_mesh l;
-    CHECK(fs_render_mesh_lift(&m, &d, 1.0, &l) == 0);
+    CHECK(fs_render_lift(&m, &d, 1.0, &l) == 0);
     char dir[] = "/tmp/fissure-test-lift-XXXXXX";
     CHECK(mkdtemp(dir) != NULL);
     char path[2][64];
@@ -311,7 +311,7 @@ static void obj_file(void)
         unlink(path[k]);
     rmdir(dir);
     fs_lifted_mesh_free(&l);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 int main(void)

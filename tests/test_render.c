@@ -10,15 +10,15 @@
 #include "check.h"
 
 /* An axis-aligned quad [u0,u1] x [v0,v1] with constant attributes. */
-static void add_quad(fs_render_mesh *m, double u0, double v0, double u1, double v1, double height, double crack,
+static void add_quad(fs_surface *m, double u0, double v0, double u1, double v1, double height, double crack,
                      double cell, double shade)
 {
-    int32_t a = fs_render_mesh_add_vertex(m, u0, v0, height, crack, cell, shade);
-    int32_t b = fs_render_mesh_add_vertex(m, u1, v0, height, crack, cell, shade);
-    int32_t c = fs_render_mesh_add_vertex(m, u1, v1, height, crack, cell, shade);
-    int32_t d = fs_render_mesh_add_vertex(m, u0, v1, height, crack, cell, shade);
-    fs_render_mesh_add_tri(m, a, b, c);
-    fs_render_mesh_add_tri(m, a, c, d);
+    int32_t a = fs_surface_add_vertex(m, u0, v0, height, crack, cell, shade);
+    int32_t b = fs_surface_add_vertex(m, u1, v0, height, crack, cell, shade);
+    int32_t c = fs_surface_add_vertex(m, u1, v1, height, crack, cell, shade);
+    int32_t d = fs_surface_add_vertex(m, u0, v1, height, crack, cell, shade);
+    fs_surface_add_tri(m, a, b, c);
+    fs_surface_add_tri(m, a, c, d);
 }
 
 static double mean(const float *x, size_t n)
@@ -42,11 +42,11 @@ static void test_half_square(void)
 {
     const int W = 64;
     const double h = 2.5;
-    fs_render_mesh m = {0};
-    int32_t a = fs_render_mesh_add_vertex(&m, 0, 0, h, 0, 7, 0);
-    int32_t b = fs_render_mesh_add_vertex(&m, 1, 0, h, 0, 7, 0);
-    int32_t c = fs_render_mesh_add_vertex(&m, 1, 1, h, 0, 7, 0);
-    fs_render_mesh_add_tri(&m, a, b, c);
+    fs_surface m = {0};
+    int32_t a = fs_surface_add_vertex(&m, 0, 0, h, 0, 7, 0);
+    int32_t b = fs_surface_add_vertex(&m, 1, 0, h, 0, 7, 0);
+    int32_t c = fs_surface_add_vertex(&m, 1, 1, h, 0, 7, 0);
+    fs_surface_add_tri(&m, a, b, c);
     fs_raster r;
     CHECK_MSG(fs_render_raster(&m, W, W, 4, false, false, &r) == 0, "%s", fs_error_message());
     size_t n = (size_t)W * W;
@@ -57,7 +57,7 @@ static void test_half_square(void)
     /* Pixels on the diagonal are partly covered: their coverage is about one half. */
     CHECK_NEAR(r.height_cm[at(&r, 10, W - 1 - 10)], h * 0.5, h * 0.25);
     fs_raster_free(&r);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 /* A quad at constant height gives exactly that height (and exact crack, cell and negative shade)
@@ -66,7 +66,7 @@ static void test_quad_exact(void)
 {
     const int W = 40, H = 24;
     const float h = 1.2345678f;
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     add_quad(&m, 0.25, 0.25, 0.75, 0.75, h, 0.0, 4321, -0.75);
     fs_raster r;
     CHECK(fs_render_raster(&m, W, H, 3, false, false, &r) == 0);
@@ -88,14 +88,14 @@ static void test_quad_exact(void)
     CHECK(inside == (W / 2) * (H / 2));
     CHECK_MSG(bad == 0, "%d pixels differ", bad);
     fs_raster_free(&r);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 /* Where triangles overlap, the higher one is seen, whichever is drawn first. */
 static void test_depth(void)
 {
     for (int order = 0; order < 2; order++) {
-        fs_render_mesh m = {0};
+        fs_surface m = {0};
         if (order == 0) {
             add_quad(&m, 0, 0, 1, 1, 1.0, 0, 1, 0);
             add_quad(&m, 0.25, 0.25, 0.75, 0.75, 1.001, 1, 2, 0);
@@ -108,7 +108,7 @@ static void test_depth(void)
         CHECK(r.cell[at(&r, 16, 16)] == 2 && r.height_cm[at(&r, 16, 16)] == 1.001f && r.crack[at(&r, 16, 16)] == 1.0f);
         CHECK(r.cell[at(&r, 2, 2)] == 1 && r.height_cm[at(&r, 2, 2)] == 1.0f && r.crack[at(&r, 2, 2)] == 0.0f);
         fs_raster_free(&r);
-        fs_render_mesh_free(&m);
+        fs_surface_free(&m);
     }
 }
 
@@ -118,14 +118,14 @@ static void test_depth(void)
 static void test_wrap(void)
 {
     const int W = 50, H = 20;
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     /* Height 10 (u - 0.9) over u in [0.9, 1.1], v in [0.25, 0.75]. */
-    int32_t a = fs_render_mesh_add_vertex(&m, 0.9, 0.25, 0.0, 0, 3, 0);
-    int32_t b = fs_render_mesh_add_vertex(&m, 1.1, 0.25, 2.0, 0, 3, 0);
-    int32_t c = fs_render_mesh_add_vertex(&m, 1.1, 0.75, 2.0, 0, 3, 0);
-    int32_t d = fs_render_mesh_add_vertex(&m, 0.9, 0.75, 0.0, 0, 3, 0);
-    fs_render_mesh_add_tri(&m, a, b, c);
-    fs_render_mesh_add_tri(&m, a, c, d);
+    int32_t a = fs_surface_add_vertex(&m, 0.9, 0.25, 0.0, 0, 3, 0);
+    int32_t b = fs_surface_add_vertex(&m, 1.1, 0.25, 2.0, 0, 3, 0);
+    int32_t c = fs_surface_add_vertex(&m, 1.1, 0.75, 2.0, 0, 3, 0);
+    int32_t d = fs_surface_add_vertex(&m, 0.9, 0.75, 0.0, 0, 3, 0);
+    fs_surface_add_tri(&m, a, b, c);
+    fs_surface_add_tri(&m, a, c, d);
     fs_raster r;
     CHECK(fs_render_raster(&m, W, H, 4, true, false, &r) == 0);
     const int j = H / 2;
@@ -141,7 +141,7 @@ static void test_wrap(void)
     CHECK(r.cell[at(&r, 0, j)] == 0 && r.cell[at(&r, W - 1, j)] == 3);
     CHECK_NEAR(1.0 - mean(r.crack, (size_t)W * H), 0.1 * 0.5, 1.0 / H);
     fs_raster_free(&r);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 
     /* Across v = 0: the quad v in [-0.1, 0.1] appears in the bottom and the top rows. */
     add_quad(&m, 0.4, -0.1, 0.6, 0.1, 1.0, 0, 9, 0);
@@ -149,14 +149,14 @@ static void test_wrap(void)
     CHECK(r.cell[at(&r, W / 2, 0)] == 9 && r.cell[at(&r, W / 2, H - 1)] == 9);
     CHECK(r.cell[at(&r, W / 2, H / 2)] == 0);
     fs_raster_free(&r);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 /* Cell ids come out as exact integers over the whole 16-bit range (each pixel its own quad). */
 static void test_cell_ids(void)
 {
     const int W = 64;
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     for (int j = 0; j < W; j++)
         for (int i = 0; i < W; i++) {
             double cell = 65535 - 16 * (j * W + i);
@@ -172,14 +172,14 @@ static void test_cell_ids(void)
     CHECK_MSG(bad == 0, "%d cell ids differ", bad);
     CHECK(r.cell[0] == 65535);
     fs_raster_free(&r);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 /* Random overlapping triangles at several heights, on both wrapping axes. With constant
  * attributes per triangle every sample is the same whichever tile holds it, so a render through
  * small tiles (10 x 10 pixels, ragged at the edges) is bit-identical to a single-tile render. With
  * sloped triangles only float rounding of interpolated values may differ. */
-static void random_mesh(fs_render_mesh *m, bool sloped)
+static void random_mesh(fs_surface *m, bool sloped)
 {
     for (int t = 0; t < 400; t++) {
         double cu = fs_rand01(1, FS_RNG_TEST, 10 * t);
@@ -190,16 +190,16 @@ static void random_mesh(fs_render_mesh *m, bool sloped)
             double du = (fs_rand01(1, FS_RNG_TEST, 10 * t + 3 + 2 * c) - 0.5) * 0.2;
             double dv = (fs_rand01(1, FS_RNG_TEST, 10 * t + 4 + 2 * c) - 0.5) * 0.2;
             double hv = sloped ? h + 0.3 * c : h;
-            v[c] = fs_render_mesh_add_vertex(m, cu + du, cv + dv, hv, t % 2, 1 + t, (t % 5) * 0.25 - 0.5);
+            v[c] = fs_surface_add_vertex(m, cu + du, cv + dv, hv, t % 2, 1 + t, (t % 5) * 0.25 - 0.5);
         }
-        fs_render_mesh_add_tri(m, v[0], v[1], v[2]);
+        fs_surface_add_tri(m, v[0], v[1], v[2]);
     }
 }
 
 static void compare_tilings(bool sloped, double tol)
 {
     const int W = 96, H = 80;
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     random_mesh(&m, sloped);
     fs_raster one, many;
     CHECK(fs_render_raster_tiled(&m, W, H, 4, true, true, 4096, &one) == 0);
@@ -219,7 +219,7 @@ static void compare_tilings(bool sloped, double tol)
     CHECK(mean(one.crack, n) > 0.05 && mean(one.crack, n) < 0.95);
     fs_raster_free(&one);
     fs_raster_free(&many);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 static void test_tiling(void)

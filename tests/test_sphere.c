@@ -1,5 +1,6 @@
-/* Tests of the conforming refinement of sphere triangles into the equirectangular texture (render/sphere.h). */
-#include "render/sphere.h"
+/* Tests of the conforming refinement of sphere triangles into the equirectangular texture (geom/sphere_surface.h). */
+#include "geom/sphere_surface.h"
+#include "render/render.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -13,7 +14,7 @@
 
 /* What the vertex callback saw: every vertex's weights, for the checks. */
 typedef struct {
-    fs_render_mesh *out;
+    fs_surface *out;
     double height;
     int32_t n, cap;
     double *w; /* 3 per vertex */
@@ -27,7 +28,7 @@ static int32_t record_vertex(void *user, double u, double v, const double w[3])
         r->w = realloc(r->w, 3 * (size_t)r->cap * sizeof *r->w);
     }
     memcpy(r->w + 3 * (size_t)r->n++, w, 3 * sizeof *w);
-    return fs_render_mesh_add_vertex(r->out, u, v, r->height, 0.0, 1.0, 0.0);
+    return fs_surface_add_vertex(r->out, u, v, r->height, 0.0, 1.0, 0.0);
 }
 
 static fs_domain sphere_domain(void)
@@ -100,7 +101,7 @@ static void draw_octahedron(const fs_sphere_refiner *s)
 static void octahedron_closes(void)
 {
     fs_domain d = sphere_domain();
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     recorder rec = {&m, 0.1, 0, 0, NULL};
     fs_sphere_refiner s = {&d, 5e-4, &m, record_vertex, &rec};
     draw_octahedron(&s);
@@ -120,7 +121,7 @@ static void octahedron_closes(void)
     CHECK(bad_weights == 0);
 
     fs_lifted_mesh l;
-    CHECK(fs_render_mesh_lift(&m, &d, 1.0, &l) == 0);
+    CHECK(fs_render_lift(&m, &d, 1.0, &l) == 0);
     int32_t *edges, bad = -1;
     int32_t n_boundary = fs_lifted_mesh_boundary(&l, &edges, &bad);
     free(edges);
@@ -132,13 +133,13 @@ static void octahedron_closes(void)
         off = fmax(off, fabs(fs_norm3(l.pos + 3 * (size_t)i) - (RADIUS + 0.1)));
     CHECK(off < 1e-6);
     fs_lifted_mesh_free(&l);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
     free(rec.w);
 }
 
 /* The distinct texture points of the vertices a drawing put on the chord between two corners (the
  * other corner's weight exactly 0), sorted by (v, u), u reduced into [0, 1). Returns the count. */
-static int chord_points(const recorder *r, const fs_render_mesh *m, int other, double *uv, int cap)
+static int chord_points(const recorder *r, const fs_surface *m, int other, double *uv, int cap)
 {
     int n = 0;
     for (int32_t i = 0; i < r->n && n < cap; i++)
@@ -178,7 +179,7 @@ static void neighbours_agree(void)
         double p[4][3]; /* a, b, c, d */
         for (int k = 0; k < 4; k++)
             fs_domain_from_uv(&d, uv[k], p[k]);
-        fs_render_mesh m1 = {0}, m2 = {0};
+        fs_surface m1 = {0}, m2 = {0};
         recorder r1 = {&m1, 0.0, 0, 0, NULL}, r2 = {&m2, 0.0, 0, 0, NULL};
         fs_sphere_refiner s1 = {&d, 5e-4, &m1, record_vertex, &r1}, s2 = {&d, 5e-4, &m2, record_vertex, &r2};
         fs_sphere_triangle(&s1, p[0], p[2], p[1]);
@@ -191,8 +192,8 @@ static void neighbours_agree(void)
         for (int k = 0; k < n1 && same; k++)
             same = c1[2 * k + 1] == c2[2 * k + 1] && fabs(c1[2 * k] - c2[2 * k]) < 1e-6;
         CHECK_MSG(same, "around the pole %d: the sides cut the chord at different points", around_pole);
-        fs_render_mesh_free(&m1);
-        fs_render_mesh_free(&m2);
+        fs_surface_free(&m1);
+        fs_surface_free(&m2);
         free(r1.w);
         free(r2.w);
     }

@@ -1,5 +1,5 @@
 /* Tests of the springs model: relaxation, uniform strain on periodic lattices, crack directions, fracture invariants, the 3-D post-process. */
-#include "model/springs.h"
+#include "model/springs/springs.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -376,7 +376,7 @@ static void test_fracture_invariants(void)
 }
 
 /* Same seed, identical breaks, positions and render mesh; another seed, other breaks. */
-static void run_small(uint64_t seed, fs_springs *s, fs_render_mesh *r, fs_mesh *m)
+static void run_small(uint64_t seed, fs_springs *s, fs_surface *r, fs_mesh *m)
 {
     fs_springs_setup st = base_setup();
     st.seed = seed;
@@ -408,7 +408,7 @@ static void test_determinism(void)
     if (!make_mesh(&d, 400, false, 2, &m))
         return;
     fs_springs a, b, c;
-    fs_render_mesh ra, rb, rc;
+    fs_surface ra, rb, rc;
     run_small(5, &a, &ra, &m);
     run_small(5, &b, &rb, &m);
     run_small(6, &c, &rc, &m);
@@ -422,9 +422,9 @@ static void test_determinism(void)
         CHECK(memcmp(ra.tri, rb.tri, 3 * (size_t)ra.n_tris * sizeof *ra.tri) == 0);
     }
     CHECK(!same_breaks(&a, &c));
-    fs_render_mesh_free(&ra);
-    fs_render_mesh_free(&rb);
-    fs_render_mesh_free(&rc);
+    fs_surface_free(&ra);
+    fs_surface_free(&rb);
+    fs_surface_free(&rc);
     fs_springs_free(&a);
     fs_springs_free(&b);
     fs_springs_free(&c);
@@ -461,7 +461,7 @@ static void test_render_depth(void)
         full += top && mid && bottom;
     }
     CHECK_MSG(partial > 0 && full > 0, "%d partial-depth and %d full-depth cracks", (int)partial, (int)full);
-    fs_render_mesh r = {0};
+    fs_surface r = {0};
     CHECK_MSG(fs_springs_render(&s, &r) == 0, "%s", fs_error_message());
     /* level 2 of 3 at its shrinkage: 0.45 * 2/3 * (1 - (0.035 + 0.015 * 2/3)) */
     double level2 = 0.45 * 2.0 / 3.0 * (1.0 - (0.035 + 0.015 * 2.0 / 3.0));
@@ -485,7 +485,7 @@ static void test_render_depth(void)
     CHECK(at_level2 > 0);
     CHECK(at_bottom > 0);
     CHECK(top_max <= 0.45 + 1e-9);
-    fs_render_mesh_free(&r);
+    fs_surface_free(&r);
 
     /* relaxed: glued walls keep the tops at most the thickness; curl mode lifts the rims above */
     double max_glue = 0.0, max_curl = 0.0;
@@ -501,7 +501,7 @@ static void test_render_depth(void)
                 hmax = fmax(hmax, r.height[v]);
         }
         *(mode ? &max_curl : &max_glue) = hmax;
-        fs_render_mesh_free(&r);
+        fs_surface_free(&r);
     }
     CHECK_MSG(max_glue <= 0.45, "glued tops reach %g cm", max_glue);
     CHECK_MSG(max_curl > max_glue, "curl %g cm, glue %g cm", max_curl, max_glue);

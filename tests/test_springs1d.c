@@ -5,7 +5,7 @@
 
 #include "base/error.h"
 #include "check.h"
-#include "model/springs1d.h"
+#include "model/springs/springs1d.h"
 
 /* The refinement levels of the convergence tests: 10, 20, 40, 80, 160 springs. The spring count is
  * even, so the bar's centre is a mass and the first crack lands half a spacing off the centre. */

@@ -184,7 +184,7 @@ static void geodesic_mesh(fs_mesh *m, double radius, int f)
 
 /* ---- measurements on a render mesh ---- */
 
-static void tri_uv(const fs_render_mesh *r, int32_t t, double (*p)[2])
+static void tri_uv(const fs_surface *r, int32_t t, double (*p)[2])
 {
     for (int k = 0; k < 3; k++) {
         int32_t v = r->tri[3 * t + k];
@@ -193,7 +193,7 @@ static void tri_uv(const fs_render_mesh *r, int32_t t, double (*p)[2])
     }
 }
 
-static double tri_area(const fs_render_mesh *r, int32_t t)
+static double tri_area(const fs_surface *r, int32_t t)
 {
     double p[3][2];
     tri_uv(r, t, p);
@@ -204,7 +204,7 @@ typedef struct {
     double abs_area, min_area, negative_area, crack_area;
 } areas;
 
-static areas measure(const fs_render_mesh *r)
+static areas measure(const fs_surface *r)
 {
     areas a = {0.0, INFINITY, 0.0, 0.0};
     for (int32_t t = 0; t < r->n_tris; t++) {
@@ -221,7 +221,7 @@ static areas measure(const fs_render_mesh *r)
 
 /* Vertices whose attributes break the render contract: cell 0 exactly on cracks, integer ids,
  * shade in [-1, 1], heights between the crack floor and the tops. */
-static int32_t bad_attributes(const fs_render_mesh *r, double depth)
+static int32_t bad_attributes(const fs_surface *r, double depth)
 {
     int32_t bad = 0;
     for (int32_t v = 0; v < r->n_verts; v++) {
@@ -259,7 +259,7 @@ typedef struct {
     int32_t unmatched, unmatched_border, across_seam, total;
 } edge_report;
 
-static edge_report match_edges(const fs_render_mesh *r, bool wu, bool wv)
+static edge_report match_edges(const fs_surface *r, bool wu, bool wv)
 {
     int G = (int)sqrt(2.0 * r->n_tris);
     G = G < 16 ? 16 : (G > 2048 ? 2048 : G);
@@ -352,7 +352,7 @@ static edge_report match_edges(const fs_render_mesh *r, bool wu, bool wv)
  * copies shifted by a period on wrapping axes) that contain the point: `gaps` points are in none,
  * `overlaps` strictly inside two or more. A point within a hair of an edge counts as in both
  * neighbours. */
-static void coverage_at(const fs_render_mesh *r, bool wu, bool wv, const double *pts, int n, int *gaps,
+static void coverage_at(const fs_surface *r, bool wu, bool wv, const double *pts, int n, int *gaps,
                         int *overlaps)
 {
     const int G = 64;
@@ -422,7 +422,7 @@ static void coverage_at(const fs_render_mesh *r, bool wu, bool wv, const double 
 }
 
 /* coverage_at at random points. */
-static void coverage(const fs_render_mesh *r, bool wu, bool wv, int samples, int *gaps, int *overlaps)
+static void coverage(const fs_surface *r, bool wu, bool wv, int samples, int *gaps, int *overlaps)
 {
     double *pts = fs_malloc(2 * (size_t)samples * sizeof *pts);
     for (int s = 0; s < 2 * samples; s++)
@@ -445,7 +445,7 @@ static double voronoi_edge_length(const fs_mesh *m)
 
 /* Top and bevel vertices of cell c (warp 0) are closer to node c - 1 than to any other node
  * (every third vertex is checked, which keeps the brute-force search short). */
-static int32_t wrong_cell_vertices(const fs_mesh *m, const fs_render_mesh *r)
+static int32_t wrong_cell_vertices(const fs_mesh *m, const fs_surface *r)
 {
     int32_t wrong = 0;
     for (int32_t v = 0; v < r->n_verts; v += 3) {
@@ -483,7 +483,7 @@ static void test_defaults(void)
 static void test_bad_input(void)
 {
     fs_voronoi_params p = fs_voronoi_params_default();
-    fs_render_mesh r;
+    fs_surface r;
     memset(&r, 0, sizeof r);
     fs_mesh empty;
     memset(&empty, 0, sizeof empty);
@@ -520,7 +520,7 @@ static void check_periodic_tiling(double warp)
     fs_voronoi_params p = fs_voronoi_params_default();
     p.warp = warp;
     p.subdivisions = 5;
-    fs_render_mesh r;
+    fs_surface r;
     memset(&r, 0, sizeof r);
     CHECK(fs_voronoi_render_mesh(&m, &p, 42, &r) == 0);
     areas a = measure(&r);
@@ -547,7 +547,7 @@ static void check_periodic_tiling(double warp)
         /* warping lengthens the cracks a little */
         CHECK_MSG(ratio > 0.93 && ratio < 1.2, "warped crack area / (edge length * width) = %g", ratio);
     }
-    fs_render_mesh_free(&r);
+    fs_surface_free(&r);
     fs_mesh_free(&m);
 }
 
@@ -568,7 +568,7 @@ static void test_warp_moves_cracks(void)
     int32_t off[2] = {0, 0}, total[2] = {0, 0};
     for (int run = 0; run < 2; run++) {
         p.warp = run ? 0.2 : 0.0;
-        fs_render_mesh r;
+        fs_surface r;
         memset(&r, 0, sizeof r);
         CHECK(fs_voronoi_render_mesh(&m, &p, 7, &r) == 0);
         for (int32_t v = 0; v < r.n_verts; v++) {
@@ -589,7 +589,7 @@ static void test_warp_moves_cracks(void)
             off[run] += d2 - d1 > p.crack_width + 1e-5;
             total[run]++;
         }
-        fs_render_mesh_free(&r);
+        fs_surface_free(&r);
     }
     CHECK_MSG(off[0] == 0, "warp 0: %d of %d crack vertices lie off the Voronoi edges", off[0], total[0]);
     CHECK_MSG(off[1] > total[1] / 4, "warp 0.2: only %d of %d crack vertices moved off", off[1], total[1]);
@@ -609,7 +609,7 @@ static void test_periodic_x_strip(void)
         grid_mesh(&m, d, 9, 7, 0.3, 11);
         fs_voronoi_params p = fs_voronoi_params_default();
         p.warp = warped ? 0.15 : 0.0;
-        fs_render_mesh r;
+        fs_surface r;
         memset(&r, 0, sizeof r);
         CHECK(fs_voronoi_render_mesh(&m, &p, 3, &r) == 0);
         areas a = measure(&r);
@@ -625,7 +625,7 @@ static void test_periodic_x_strip(void)
         int gaps, overlaps;
         coverage(&r, true, false, 3000, &gaps, &overlaps);
         CHECK_MSG(gaps == 0 && overlaps == 0, "%d gaps, %d overlaps", gaps, overlaps);
-        fs_render_mesh_free(&r);
+        fs_surface_free(&r);
         fs_mesh_free(&m);
     }
 }
@@ -638,7 +638,7 @@ static void test_ids_and_determinism(void)
     fs_mesh m;
     grid_mesh(&m, d, 7, 7, 0.2, 9);
     fs_voronoi_params p = fs_voronoi_params_default();
-    fs_render_mesh r1, r2, r3;
+    fs_surface r1, r2, r3;
     memset(&r1, 0, sizeof r1);
     memset(&r2, 0, sizeof r2);
     memset(&r3, 0, sizeof r3);
@@ -667,9 +667,9 @@ static void test_ids_and_determinism(void)
         missing += seen[k] == 0;
     CHECK_MSG(missing == 0, "%d cells have no vertices", missing);
     CHECK_MSG(bad_shade == 0, "%d vertices with a shade that is not their cell's", bad_shade);
-    fs_render_mesh_free(&r1);
-    fs_render_mesh_free(&r2);
-    fs_render_mesh_free(&r3);
+    fs_surface_free(&r1);
+    fs_surface_free(&r2);
+    fs_surface_free(&r3);
     fs_mesh_free(&m);
 }
 
@@ -701,7 +701,7 @@ static void test_sphere(void)
         fs_voronoi_params p = fs_voronoi_params_default();
         p.warp = warped ? 0.1 : 0.0;
         p.warp_scale = 1.5;
-        fs_render_mesh r;
+        fs_surface r;
         memset(&r, 0, sizeof r);
         CHECK(fs_voronoi_render_mesh(&m, &p, 8, &r) == 0);
         areas a = measure(&r);
@@ -734,7 +734,7 @@ static void test_sphere(void)
         if (!warped)
             CHECK_MSG(wrong_cell_vertices(&m, &r) == 0, "%d sphere cell vertices nearer another node",
                       wrong_cell_vertices(&m, &r));
-        fs_render_mesh_free(&r);
+        fs_surface_free(&r);
     }
     fs_mesh_free(&m);
 }
@@ -755,7 +755,7 @@ static void check_delaunay(fs_domain d, int32_t count, double warp)
     CHECK(fs_delaunay(&d, &pts, &m) == 0);
     fs_voronoi_params p = fs_voronoi_params_default();
     p.warp = warp;
-    fs_render_mesh r;
+    fs_surface r;
     memset(&r, 0, sizeof r);
     CHECK(fs_voronoi_render_mesh(&m, &p, 4, &r) == 0);
     const char *name = fs_domain_type_name(d.type);
@@ -784,7 +784,7 @@ static void check_delaunay(fs_domain d, int32_t count, double warp)
     if (warp == 0.0)
         CHECK_MSG(wrong_cell_vertices(&m, &r) == 0, "%s: %d cell vertices nearer another node", name,
                   wrong_cell_vertices(&m, &r));
-    fs_render_mesh_free(&r);
+    fs_surface_free(&r);
     fs_mesh_free(&m);
     fs_points_free(&pts);
 }

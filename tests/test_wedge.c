@@ -13,9 +13,9 @@
 #include "geom/delaunay.h"
 #include "geom/refine.h"
 #include "geom/sample.h"
-#include "io/image.h"
-#include "model/wedge.h"
-#include "model/wedge_element.h"
+#include "image/image.h"
+#include "model/wedge/wedge.h"
+#include "model/wedge/element.h"
 
 /* A configuration for the wedge model: E = 10000 MPa, nu = 0.3, no jitter, no growth, no shrinkage. */
 static fs_config base_config(void)
@@ -455,7 +455,7 @@ static void test_removal_run(void)
     int32_t *label = malloc((size_t)w.n_elems * sizeof *label);
     int32_t fragments = fs_wedge_fragments(&w, label);
     CHECK_MSG(fragments >= 2, "%d fragments", (int)fragments);
-    fs_render_mesh r;
+    fs_surface r;
     CHECK(fs_wedge_render_mesh(&w, &r) == 0);
     CHECK(r.n_tris == w.n_elems);
     int cracks = 0, bad = 0;
@@ -468,7 +468,7 @@ static void test_removal_run(void)
     }
     CHECK(cracks == w.fractures);
     CHECK(bad == 0);
-    fs_render_mesh_free(&r);
+    fs_surface_free(&r);
     free(label);
     fs_wedge_free(&w);
     fs_mesh_free(&m);
@@ -639,7 +639,7 @@ static void test_thickness_gradient_and_map(void)
     fs_wedge_model w;
     CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
     CHECK(fs_wedge_equilibrium(&w, 0.0) == 0);
-    fs_render_mesh r;
+    fs_surface r;
     CHECK(fs_wedge_render_mesh(&w, &r) == 0);
     double worst = 0.0;
     for (int32_t v = 0; v < r.n_verts; v++) {
@@ -651,7 +651,7 @@ static void test_thickness_gradient_and_map(void)
         worst = fmax(worst, fabs(r.height[v] - expect));
     }
     CHECK_MSG(worst < 0.5 * 0.01, "heights off by %.3g cm", worst);
-    fs_render_mesh_free(&r);
+    fs_surface_free(&r);
     fs_wedge_free(&w);
     fs_mesh_free(&m);
     remove(path);

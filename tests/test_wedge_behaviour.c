@@ -10,7 +10,7 @@
 #include "geom/delaunay.h"
 #include "geom/sample.h"
 #include "io/preset.h"
-#include "model/wedge.h"
+#include "model/wedge/wedge.h"
 
 #define DEG (180.0 / 3.14159265358979323846)
 

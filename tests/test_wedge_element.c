@@ -5,7 +5,7 @@
 #include "base/error.h"
 #include "base/rng.h"
 #include "check.h"
-#include "model/wedge_element.h"
+#include "model/wedge/element.h"
 
 /* A general wedge: non-right bottom triangle off the z = 0 plane, each top node shifted differently
  * (sheared, tapered, twisted). Node i + 3 is above node i. Lengths in cm. */

@@ -9,7 +9,7 @@
 #include "wedge_fixture.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
-#include "model/wedge.h"
+#include "model/wedge/wedge.h"
 
 /* A bonded layer 0.2 cm thick, E = 10000 MPa, nu = 0.3, whose top shrinks twice as fast as its bottom. */
 static fs_config base_config(double size, fs_relax_mode relax)

@@ -1,4 +1,4 @@
-/* Tests of the wedge model's render mesh (model/wedge_render.c): with element splitting, the fragment tops and the crack floor partition texture space, and the lift closes every crack with walls. */
+/* Tests of the wedge model's render mesh (model/wedge/surface.c): with element splitting, the fragment tops and the crack floor partition texture space, and the lift closes every crack with walls. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,7 +9,7 @@
 #include "geom/delaunay.h"
 #include "geom/sample.h"
 #include "io/preset.h"
-#include "model/wedge.h"
+#include "model/wedge/wedge.h"
 
 /* A preset of presets/ with the given element count and seed, fracture by splitting. */
 static fs_config preset_config(const char *name, int32_t elements, uint64_t seed)
@@ -27,7 +27,7 @@ static fs_config preset_config(const char *name, int32_t elements, uint64_t seed
 
 /* Samples, meshes and simulates cfg as fs_sim_run does for the wedge model; returns the render mesh
  * of the final state (and the domain) in *out. Returns 0 or -1. */
-static int run(const fs_config *cfg, fs_render_mesh *out, fs_domain *domain)
+static int run(const fs_config *cfg, fs_surface *out, fs_domain *domain)
 {
     fs_domain d = cfg->domain;
     fs_domain_normalize(&d);
@@ -60,7 +60,7 @@ static int run(const fs_config *cfg, fs_render_mesh *out, fs_domain *domain)
 }
 
 /* Twice the signed area of render triangle t in texture space. */
-static double uv_area2(const fs_render_mesh *m, int32_t t)
+static double uv_area2(const fs_surface *m, int32_t t)
 {
     const float *a = m->uv + 2 * m->tri[3 * t], *b = m->uv + 2 * m->tri[3 * t + 1], *c = m->uv + 2 * m->tri[3 * t + 2];
     return ((double)b[0] - a[0]) * ((double)c[1] - a[1]) - ((double)b[1] - a[1]) * ((double)c[0] - a[0]);
@@ -120,7 +120,7 @@ static long merged_euler(const fs_lifted_mesh *l)
 static void check_partition(const char *preset, int32_t elements, uint64_t seed, long euler_expected)
 {
     fs_config cfg = preset_config(preset, elements, seed);
-    fs_render_mesh m = {0};
+    fs_surface m = {0};
     fs_domain d;
     int rc = run(&cfg, &m, &d);
     CHECK_MSG(rc == 0, "%s: %s", preset, fs_error_message());
@@ -152,7 +152,7 @@ static void check_partition(const char *preset, int32_t elements, uint64_t seed,
     CHECK_MSG(floor > 1e-4 && floor < 0.2, "%s: crack floor %g of the texture", preset, floor);
 
     fs_lifted_mesh l;
-    CHECK(fs_render_mesh_lift(&m, &d, 1.0, &l) == 0);
+    CHECK(fs_render_lift(&m, &d, 1.0, &l) == 0);
     int32_t *edges, bad = -1, walls = 0, off_border = 0;
     int32_t n_b = fs_lifted_mesh_boundary(&l, &edges, &bad);
     for (int32_t t = 0; t < l.n_tris; t++)
@@ -179,7 +179,7 @@ static void check_partition(const char *preset, int32_t elements, uint64_t seed,
     CHECK_MSG(off_border == 0, "%s: %d boundary edges inside the domain (cracks left open)", preset, (int)off_border);
     CHECK_MSG(chi == euler_expected, "%s: Euler characteristic %ld, expected %ld", preset, chi, euler_expected);
     fs_lifted_mesh_free(&l);
-    fs_render_mesh_free(&m);
+    fs_surface_free(&m);
 }
 
 /* Drying mud on a periodic tile: polygons with T-junctions. */

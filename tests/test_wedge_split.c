@@ -11,7 +11,7 @@
 #include "geom/delaunay.h"
 #include "geom/refine.h"
 #include "geom/sample.h"
-#include "model/wedge.h"
+#include "model/wedge/wedge.h"
 
 /* Crack edges of a periodic mesh: boundary half-edges (each crack edge appears once per side). Sums
  * their length and the length-weighted doubled-angle moments of their directions. */

@@ -12,7 +12,7 @@
 #include "geom/delaunay.h"
 #include "geom/refine.h"
 #include "geom/sample.h"
-#include "model/wedge.h"
+#include "model/wedge/wedge.h"
 
 /* The strip of wedge_fixture.h, relaxed to a tight tolerance. */
 static fs_config strip_config(void)
@@ -218,7 +218,7 @@ static double indicator_away(const fs_wedge_model *w, const double *ind, double 
 /* Around a short crack in a stretched layer the von Mises stresses of a node's elements disagree;
  * rounds of Algorithm 13 bisect there and nowhere far from the crack, keep the mesh conforming and
  * its area, and bring the indicator below the threshold everywhere but at the crack tips, where the
- * stress is singular (the indicator there does not vanish under refinement, see wedge_tips.c). */
+ * stress is singular (the indicator there does not vanish under refinement, see wedge/tips.c). */
 static void test_vm_refinement(void)
 {
     const double threshold = 0.25;
@@ -272,7 +272,7 @@ static void test_vm_refinement(void)
     fs_mesh_free(&m);
 }
 
-/* The coarse estimate at a tip (wedge_split.c): the largest ratio among its elements' top Gauss points
+/* The coarse estimate at a tip (wedge/split.c): the largest ratio among its elements' top Gauss points
  * nearest it. */
 static double coarse_estimate(const fs_wedge_model *w, int32_t tip)
 {

@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "base/error.h"
-#include "io/image.h"
+#include "image/image.h"
 
 static double sample(const fs_image *img, int x, int y, int c)
 {

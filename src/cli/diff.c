@@ -9,7 +9,7 @@
 
 #include "base/error.h"
 #include "cli/cli.h"
-#include "io/image.h"
+#include "image/image.h"
 
 static void print_diff_help(FILE *out)
 {

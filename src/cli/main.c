@@ -331,7 +331,7 @@ static fs_output *stage_mesh(const char *path, const fs_config *cfg, const fs_re
     if (!out)
         return NULL;
     fs_lifted_mesh lifted;
-    int rc = fs_render_mesh_lift(&res->surface, &cfg->domain, 1.0, &lifted);
+    int rc = fs_render_lift(&res->surface, &cfg->domain, 1.0, &lifted);
     if (rc == 0) {
         char comment[200];
         snprintf(comment, sizeof comment, "fissure %s: preset %s, seed %" PRIu64 ", %s model on a %s", PACKAGE_VERSION,
@@ -400,7 +400,7 @@ static void frame_writer_free(frame_writer *fw)
 }
 
 /* fs_frame_fn: renders frame k's maps and stages them as NAME_frame_KKKK_KIND.png. */
-static int write_frame(void *ctx, int32_t k, int32_t count, double t, const fs_render_mesh *surface,
+static int write_frame(void *ctx, int32_t k, int32_t count, double t, const fs_surface *surface,
                        const fs_stats *stats)
 {
     frame_writer *fw = ctx;

@@ -4,7 +4,7 @@
 
 #include <stdbool.h>
 
-#include "io/image.h"
+#include "image/image.h"
 #include "io/output.h"
 #include "io/sidecar.h"
 #include "render/crackgraph.h"

@@ -9,7 +9,7 @@
 #include "base/rng.h"
 #include "base/vec.h"
 #include "field/noise.h"
-#include "render/sphere.h"
+#include "geom/sphere_surface.h"
 
 /* design: a cell is the polygon of the circumcentres of its node's ring, brought into the node's
  * frame (plane, cylinder) with the corner shifts; an open ring (a node on the convex hull of a
@@ -29,7 +29,7 @@
  * resolution. Border segments of a clipped cell continue the distance of the Voronoi segment next
  * to them (zone_polyline).
  *   Sphere: the bands are built on the chords in 3-D and drawn by fs_sphere_triangle
- * (render/sphere.h), which refines them edge by edge until the equirectangular map is close to
+ * (geom/sphere_surface.h), which refines them edge by edge until the equirectangular map is close to
  * affine on each piece, still conforming, and cuts a triangle containing a pole at the pole. */
 
 fs_voronoi_params fs_voronoi_params_default(void)
@@ -49,7 +49,7 @@ enum { SEG_BORDER = 0, SEG_CRACK = 1 };
 enum { BAND_CRACK = 0, BAND_BEVEL = 1, BAND_TOP = 2 };
 
 /* Sphere refinement: largest uv deviation of a chord's image from the straight line before the
- * chord is halved (render/sphere.h). */
+ * chord is halved (geom/sphere_surface.h). */
 #define SPHERE_UV_TOLERANCE 2e-4
 
 /* Vertex attributes of the render mesh besides the position. */
@@ -83,7 +83,7 @@ typedef struct {
     const fs_mesh *m;
     const fs_voronoi *vor;
     const fs_voronoi_params *prm;
-    fs_render_mesh *out;
+    fs_surface *out;
     bool sphere;
     double ext[2];         /* extents of the unwrapped rectangle (plane, cylinder) */
     bool wraps[2];         /* the domain is periodic along x / y */
@@ -356,7 +356,7 @@ static void band_tri_add(ctx *c, int a, int b, int d)
 
 static void add_vertex(ctx *c, double u, double v, attr a)
 {
-    fs_render_mesh_add_vertex(c->out, u, v, a.height, a.crack, a.cell, a.shade);
+    fs_surface_add_vertex(c->out, u, v, a.height, a.crack, a.cell, a.shade);
 }
 
 /* fs_sphere_refiner.vertex: a vertex with the attributes of the band triangle's corners mixed by w. */
@@ -365,7 +365,7 @@ static int32_t sphere_vertex(void *user, double u, double v, const double w[3])
     ctx *c = user;
     const band_vertex *const *t = c->sphere_corner;
     attr a = attr_bary(t[0]->a, t[1]->a, t[2]->a, w[1], w[2]);
-    return fs_render_mesh_add_vertex(c->out, u, v, a.height, a.crack, a.cell, a.shade);
+    return fs_surface_add_vertex(c->out, u, v, a.height, a.crack, a.cell, a.shade);
 }
 
 /* Sends the collected band vertices and triangles to the render mesh. */
@@ -383,7 +383,7 @@ static void flush_band(ctx *c)
         for (int k = 0; k < c->n_bv; k++)
             add_vertex(c, c->bv[k].p[0] / c->ext[0], c->bv[k].p[1] / c->ext[1], c->bv[k].a);
         for (int k = 0; k < c->n_bt; k += 3)
-            fs_render_mesh_add_tri(c->out, base + c->bt[k], base + c->bt[k + 1], base + c->bt[k + 2]);
+            fs_surface_add_tri(c->out, base + c->bt[k], base + c->bt[k + 1], base + c->bt[k + 2]);
     }
     c->n_bv = 0;
     c->n_bt = 0;
@@ -691,7 +691,7 @@ static int check_params(const fs_voronoi_params *p)
     return 0;
 }
 
-int fs_voronoi_render_mesh(const fs_mesh *m, const fs_voronoi_params *p, uint64_t seed, fs_render_mesh *out)
+int fs_voronoi_render_mesh(const fs_mesh *m, const fs_voronoi_params *p, uint64_t seed, fs_surface *out)
 {
     if (m->n_nodes <= 0 || m->n_tris <= 0) {
         fs_error(FS_ERR_DATA, "voronoi: the mesh has no nodes or triangles");

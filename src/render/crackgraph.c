@@ -7,7 +7,7 @@
 
 #include "base/error.h"
 #include "base/vec.h"
-#include "io/image.h"
+#include "image/image.h"
 
 fs_crackgraph_params fs_crackgraph_params_default(void)
 {

@@ -1122,7 +1122,7 @@ static void build_normals(const lift_ctx *c, fs_lifted_mesh *out)
     free(star);
 }
 
-int fs_render_mesh_lift(const fs_render_mesh *m, const fs_domain *dom, double height_scale, fs_lifted_mesh *out)
+int fs_render_lift(const fs_surface *m, const fs_domain *dom, double height_scale, fs_lifted_mesh *out)
 {
     memset(out, 0, sizeof *out);
     lift_ctx c;

@@ -4,7 +4,7 @@
 
 #include <stdbool.h>
 
-#include "io/image.h"
+#include "image/image.h"
 #include "render/render.h"
 
 typedef struct {

@@ -52,7 +52,7 @@ typedef struct {
     const uint32_t *tri; /* 3 * n_tris vertex indices */
 } fs_osmesa_mesh;
 
-/* 8-bit RGB images of the same layout (rows top to bottom, as io/image.h), repeated or clamped per
+/* 8-bit RGB images of the same layout (rows top to bottom, as image/image.h), repeated or clamped per
  * axis: colour in sRGB, and a tangent-space normal map n * 0.5 + 0.5 whose green is
  * normal_green_sign times the v component. */
 typedef struct {

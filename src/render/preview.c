@@ -367,7 +367,7 @@ static void backdrop(int i, int j, int w, int h, double *rgb)
         rgb[q] = (top[q] + (bottom[q] - top[q]) * t) * (0.75 + 0.25 * glow);
 }
 
-int fs_render_preview(const fs_render_mesh *rm, const fs_domain *dom, const fs_render_params *p, const fs_maps *maps,
+int fs_render_preview(const fs_surface *rm, const fs_domain *dom, const fs_render_params *p, const fs_maps *maps,
                       fs_image *out)
 {
     memset(out, 0, sizeof *out);
@@ -384,7 +384,7 @@ int fs_render_preview(const fs_render_mesh *rm, const fs_domain *dom, const fs_r
     fs_domain d = *dom;
     fs_domain_normalize(&d);
     fs_lifted_mesh l;
-    if (fs_render_mesh_lift(rm, &d, p->height_scale, &l) < 0)
+    if (fs_render_lift(rm, &d, p->height_scale, &l) < 0)
         return -1;
     int32_t *edges = NULL, n_bad = 0;
     int32_t n_edges = fs_lifted_mesh_boundary(&l, &edges, &n_bad);

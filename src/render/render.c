@@ -28,64 +28,6 @@ fs_render_params fs_render_params_default(void)
     return p;
 }
 
-static int32_t grow_capacity(int32_t cap, int32_t need)
-{
-    FS_ASSERT(need > 0 && need < INT32_MAX / 2);
-    int32_t c = cap ? cap : 64;
-    while (c < need)
-        c *= 2;
-    return c;
-}
-
-int32_t fs_render_mesh_add_vertex(fs_render_mesh *m, double u, double v, double height, double crack,
-                                  double cell, double shade)
-{
-    if (m->n_verts == m->cap_verts) {
-        int32_t cap = grow_capacity(m->cap_verts, m->n_verts + 1);
-        m->uv = fs_realloc(m->uv, 2 * (size_t)cap * sizeof *m->uv);
-        m->height = fs_realloc(m->height, (size_t)cap * sizeof *m->height);
-        m->crack = fs_realloc(m->crack, (size_t)cap * sizeof *m->crack);
-        m->cell = fs_realloc(m->cell, (size_t)cap * sizeof *m->cell);
-        m->shade = fs_realloc(m->shade, (size_t)cap * sizeof *m->shade);
-        m->cap_verts = cap;
-    }
-    int32_t i = m->n_verts++;
-    m->uv[2 * i] = (float)u;
-    m->uv[2 * i + 1] = (float)v;
-    m->height[i] = (float)height;
-    m->crack[i] = (float)crack;
-    m->cell[i] = (float)cell;
-    m->shade[i] = (float)shade;
-    return i;
-}
-
-void fs_render_mesh_add_tri(fs_render_mesh *m, int32_t a, int32_t b, int32_t c)
-{
-    FS_ASSERT(a >= 0 && a < m->n_verts && b >= 0 && b < m->n_verts && c >= 0 && c < m->n_verts);
-    if (m->n_tris == m->cap_tris) {
-        int32_t cap = grow_capacity(m->cap_tris, m->n_tris + 1);
-        m->tri = fs_realloc(m->tri, 3 * (size_t)cap * sizeof *m->tri);
-        m->cap_tris = cap;
-    }
-    int32_t t = m->n_tris++;
-    m->tri[3 * t] = a;
-    m->tri[3 * t + 1] = b;
-    m->tri[3 * t + 2] = c;
-}
-
-void fs_render_mesh_free(fs_render_mesh *m)
-{
-    if (!m)
-        return;
-    free(m->uv);
-    free(m->height);
-    free(m->crack);
-    free(m->cell);
-    free(m->shade);
-    free(m->tri);
-    memset(m, 0, sizeof *m);
-}
-
 void fs_raster_free(fs_raster *r)
 {
     if (!r)
@@ -110,7 +52,7 @@ typedef struct {
 
 /* Everything one render needs besides the mesh. */
 typedef struct {
-    const fs_render_mesh *m;
+    const fs_surface *m;
     int width, height, ss;
     int tile_w, tile_h;   /* tile size in pixels (the buffer is tile_w*ss x tile_h*ss samples) */
     double su, sv;        /* samples per unit of u and v */
@@ -147,7 +89,7 @@ static const double subpixels = 256.0;
  * the result is exact in float and the same edge passes through the same samples in every tile. */
 static void place_verts(const render_job *j, const tile_window *t, double du, double dv)
 {
-    const fs_render_mesh *m = j->m;
+    const fs_surface *m = j->m;
     for (int32_t i = 0; i < m->n_verts; i++) {
         double x = floor(((double)m->uv[2 * i] + du) * j->su * subpixels + 0.5) / subpixels;
         double y = floor(((double)m->uv[2 * i + 1] + dv) * j->sv * subpixels + 0.5) / subpixels;
@@ -219,7 +161,7 @@ static int render_tile(render_job *j, const tile_window *t, bool wrap_u, bool wr
  * tile holds it. Depth is height (osmesa.h), so the highest surface
  * wins. On wrapping axes each triangle near the tile is also drawn shifted by +-1 period; the
  * culling by bounding box makes that cost nothing for triangles away from the seams. */
-int fs_render_raster_tiled(const fs_render_mesh *m, int width, int height, int supersample, bool wrap_u,
+int fs_render_raster_tiled(const fs_surface *m, int width, int height, int supersample, bool wrap_u,
                            bool wrap_v, int tile_samples, fs_raster *out)
 {
     FS_ASSERT(width > 0 && height > 0 && supersample >= 1 && supersample <= 8 && tile_samples >= 1);
@@ -308,7 +250,7 @@ int fs_render_raster_tiled(const fs_render_mesh *m, int width, int height, int s
     return rc;
 }
 
-int fs_render_raster(const fs_render_mesh *m, int width, int height, int supersample, bool wrap_u, bool wrap_v,
+int fs_render_raster(const fs_surface *m, int width, int height, int supersample, bool wrap_u, bool wrap_v,
                      fs_raster *out)
 {
     return fs_render_raster_tiled(m, width, height, supersample, wrap_u, wrap_v, FS_RENDER_TILE_SAMPLES, out);

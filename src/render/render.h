@@ -6,7 +6,8 @@
 #include <stdint.h>
 
 #include "geom/domain.h"
-#include "io/image.h"
+#include "geom/surface.h"
+#include "image/image.h"
 
 typedef enum { FS_NORMAL_OPENGL = 0, FS_NORMAL_DIRECTX = 1 } fs_normal_convention;
 
@@ -26,28 +27,6 @@ typedef struct {
 /* 1024 x 1024, supersample 4, 1024 x 768 preview, height scale 1, OpenGL normals, a warm clay palette. */
 fs_render_params fs_render_params_default(void);
 
-/* A triangle mesh in texture space with per-vertex attributes; what every model hands the renderer.
- * design: the view is orthographic from above and the highest surface wins (depth = height), so
- * crack walls, floors and cell tops can overlap freely. Triangles may extend outside [0,1]^2 by less
- * than one period; on wrapping axes the renderer also draws them shifted by one period. */
-typedef struct {
-    int32_t n_verts;
-    float *uv;       /* 2 * n_verts texture coordinates */
-    float *height;   /* n_verts height above the background (cm) */
-    float *crack;    /* n_verts: 1 in a crack (gap or wall), 0 on material; drives the crack mask */
-    float *cell;     /* n_verts fragment id as an exact small integer (<= 65535), 0 for crack */
-    float *shade;    /* n_verts colour variation in [-1, 1] */
-    int32_t n_tris;
-    int32_t *tri;    /* 3 * n_tris vertex indices */
-    int32_t cap_verts, cap_tris; /* allocated capacities (for fs_render_mesh_add_*) */
-} fs_render_mesh;
-
-/* Appends a vertex; returns its index. Grows the arrays as needed. */
-int32_t fs_render_mesh_add_vertex(fs_render_mesh *m, double u, double v, double height, double crack,
-                                  double cell, double shade);
-void fs_render_mesh_add_tri(fs_render_mesh *m, int32_t a, int32_t b, int32_t c);
-void fs_render_mesh_free(fs_render_mesh *m);
-
 /* Per-pixel results of a render, area-averaged over the supersamples except cell (centre sample).
  * Pixel convention (all rasters and maps): pixel (i, j) is column i from the left and row j from the
  * top, stored at j * width + i; it covers u in [i/W, (i+1)/W] and v in [1 - (j+1)/H, 1 - j/H], with
@@ -66,14 +45,14 @@ typedef struct {
 /* Renders m through OSMesa into a width x height raster (tiles internally so that supersampled
  * buffers stay small). wrap_u / wrap_v draw shifted copies so periodic maps have no seam.
  * Returns 0, or -1 with fs_error(FS_ERR_INTERNAL) when OSMesa cannot be set up. */
-int fs_render_raster(const fs_render_mesh *m, int width, int height, int supersample, bool wrap_u,
+int fs_render_raster(const fs_surface *m, int width, int height, int supersample, bool wrap_u,
                      bool wrap_v, fs_raster *out);
 
 /* fs_render_raster with an explicit tile limit: tiles hold at most tile_samples x tile_samples
  * supersamples (fs_render_raster uses FS_RENDER_TILE_SAMPLES). The result does not depend on the
  * tiling except for float rounding in interpolated attributes; exposed for tests. */
 #define FS_RENDER_TILE_SAMPLES 2048
-int fs_render_raster_tiled(const fs_render_mesh *m, int width, int height, int supersample, bool wrap_u,
+int fs_render_raster_tiled(const fs_surface *m, int width, int height, int supersample, bool wrap_u,
                            bool wrap_v, int tile_samples, fs_raster *out);
 void fs_raster_free(fs_raster *r);
 
@@ -103,7 +82,7 @@ void fs_maps_free(fs_maps *m);
 typedef struct {
     int32_t n_pos;
     double *pos;         /* 3 per position, world cm; no two closer than weld_tolerance unless equal:
-                          * equal ones are copies where fragments touch (see fs_render_mesh_lift) */
+                          * equal ones are copies where fragments touch (see fs_render_lift) */
     int32_t n_uv;
     float *uv;           /* 2 per texture vertex, in [0, 1]; v is the maps' v (up the image) */
     int32_t n_normal;
@@ -133,7 +112,7 @@ typedef struct {
  * normals of the triangles around the position within 50 degrees of the corner's own triangle, so
  * walls and tops keep a crisp edge. Returns 0, or -1 with fs_error(FS_ERR_INTERNAL) for a
  * non-finite vertex. */
-int fs_render_mesh_lift(const fs_render_mesh *m, const fs_domain *d, double height_scale, fs_lifted_mesh *out);
+int fs_render_lift(const fs_surface *m, const fs_domain *d, double height_scale, fs_lifted_mesh *out);
 void fs_lifted_mesh_free(fs_lifted_mesh *l);
 
 /* Edges (pairs of position indices) used by exactly one triangle, in the direction their triangle
@@ -154,7 +133,7 @@ int32_t fs_lifted_mesh_vertices(const fs_lifted_mesh *l, int32_t **vert, uint32_
  * sphere, into a p->preview_width x p->preview_height RGB 8-bit sRGB image (allocated into *out).
  * Deterministic for a given mesh on a given machine. Returns 0, or -1 with fs_error
  * (FS_ERR_DATA for a size outside 16..16384, FS_ERR_INTERNAL when OSMesa fails). */
-int fs_render_preview(const fs_render_mesh *m, const fs_domain *d, const fs_render_params *p, const fs_maps *maps,
+int fs_render_preview(const fs_surface *m, const fs_domain *d, const fs_render_params *p, const fs_maps *maps,
                       fs_image *out);
 
 #endif

@@ -7,7 +7,7 @@
 
 #include "field/field.h"
 #include "geom/domain.h"
-#include "model/springs.h"
+#include "model/springs/springs.h"
 #include "model/voronoi.h"
 #include "render/render.h"
 

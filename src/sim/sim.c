@@ -8,9 +8,9 @@
 #include "base/log.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
-#include "model/springs.h"
+#include "model/springs/springs.h"
 #include "model/voronoi.h"
-#include "model/wedge.h"
+#include "model/wedge/wedge.h"
 
 /* Points for the mesh: particle repulsion, or the hexagonal lattice. */
 static int sample_points(const fs_config *cfg, fs_points *pts)
@@ -55,14 +55,14 @@ static int run_springs_frames(const fs_config *cfg, const fs_sim_frames *frames,
             break;
         fs_progress("springs", -1, "frame %d of %d: 3-D post-process of %d cells", (int)k, (int)frames->count,
                     (int)out->mesh.n_nodes);
-        fs_render_mesh frame = {0};
-        fs_render_mesh *surface = k == frames->count ? &out->surface : &frame;
+        fs_surface frame = {0};
+        fs_surface *surface = k == frames->count ? &out->surface : &frame;
         rc = fs_springs_render(&s, surface);
         out->stats.fractures = s.break_count;
         out->stats.simulated_time = s.time;
         if (rc == 0)
             rc = frames->fn(frames->ctx, k, frames->count, t, surface, &out->stats);
-        fs_render_mesh_free(&frame);
+        fs_surface_free(&frame);
     }
     fs_springs_free(&s);
     return rc;
@@ -81,15 +81,15 @@ static int run_wedge_frames(const fs_config *cfg, const fs_sim_frames *frames, f
         rc = fs_wedge_simulate(&w, t);
         if (rc < 0)
             break;
-        fs_render_mesh frame = {0};
-        fs_render_mesh *surface = k == frames->count ? &out->surface : &frame;
+        fs_surface frame = {0};
+        fs_surface *surface = k == frames->count ? &out->surface : &frame;
         rc = fs_wedge_render_mesh(&w, surface);
         out->stats.fractures = w.fractures;
         out->stats.simulated_time = w.time;
         out->stats.elements = w.n_elems;
         if (rc == 0)
             rc = frames->fn(frames->ctx, k, frames->count, t, surface, &out->stats);
-        fs_render_mesh_free(&frame);
+        fs_surface_free(&frame);
     }
     fs_wedge_free(&w);
     return rc;
@@ -173,6 +173,6 @@ int fs_sim_run_frames(const fs_config *cfg, const fs_sim_frames *frames, fs_resu
 void fs_result_free(fs_result *r)
 {
     fs_mesh_free(&r->mesh);
-    fs_render_mesh_free(&r->surface);
+    fs_surface_free(&r->surface);
     memset(r, 0, sizeof *r);
 }

@@ -18,13 +18,13 @@ typedef struct {
 
 typedef struct {
     fs_mesh mesh;            /* the final mesh */
-    fs_render_mesh surface;  /* what the renderer draws */
+    fs_surface surface;  /* what the renderer draws */
     fs_stats stats;
 } fs_result;
 
 /* Called for time-lapse frame k (1 .. count) with the render mesh of the state at time t (borrowed,
  * valid during the call) and the statistics so far. Returns 0, or -1 with fs_error to stop the run. */
-typedef int (*fs_frame_fn)(void *ctx, int32_t k, int32_t count, double t, const fs_render_mesh *surface,
+typedef int (*fs_frame_fn)(void *ctx, int32_t k, int32_t count, double t, const fs_surface *surface,
                            const fs_stats *stats);
 
 /* Time-lapse frames (--frames): count >= 1 states at t_k = k end / count, k = 1 .. count. */

@@ -7,7 +7,7 @@
 
 #include "field/growth.h"
 #include "geom/mesh.h"
-#include "render/render.h"
+#include "geom/surface.h"
 #include "sim/settings.h"
 #include "sim/sim.h"
 #include "solve/sparse.h"
@@ -77,14 +77,14 @@ typedef struct {
     double event_relax_seconds; /* their time, local or global */
     double event_seconds;      /* the events' whole time: the fracture (the cut, the system's update or
                                   re-factorization) and the relaxation */
-    int64_t vm_rounds;         /* rounds of refinement by von Mises discontinuity that bisected (wedge_tips.c) */
+    int64_t vm_rounds;         /* rounds of refinement by von Mises discontinuity that bisected (wedge/tips.c) */
     int64_t vm_bisections;     /* their bisections (also counted in subdivisions) */
     double vm_seconds;         /* their time: indicators, subdivision, re-solves */
-    int64_t submodels;         /* crack-tip sub-models solved (wedge_tips.c) */
+    int64_t submodels;         /* crack-tip sub-models solved (wedge/tips.c) */
     int64_t submodel_elements; /* their elements after refinement, summed */
     int64_t submodel_rejections; /* picked tips the sub-model found below their threshold */
     double submodel_seconds;   /* their time: extraction, refinement, assembly, solve */
-    int64_t smoothings;        /* angle-smoothing passes around new tips (wedge_tips.c) */
+    int64_t smoothings;        /* angle-smoothing passes around new tips (wedge/tips.c) */
     int64_t smoothed_nodes;    /* nodes they moved */
     double smooth_seconds;     /* their time, the system's update included (not the relaxation) */
 } fs_wedge_counters;
@@ -150,7 +150,7 @@ typedef struct {
                                     could have reached 1 (wedge.c, element_ratios); set by
                                     fs_wedge_run for element removal, off by default */
     double *node_ratio;          /* per node: the nodal ratio of the split criterion at the current
-                                    stresses (wedge_split.c), or only an upper bound of it where
+                                    stresses (wedge/split.c), or only an upper bound of it where
                                     node_ratio_exact is 0; NaN when it must be recomputed: set
                                     NaN for the corners of every element whose stresses or
                                     neighbourhood change */
@@ -188,7 +188,7 @@ typedef struct {
                                     fs_wedge_relax call: the unit of cfg.solver.relax_radius and the
                                     smallest radius (one ring); 0 before that call */
     double relax_radius;         /* local relaxation radius (cm), adapted by fs_wedge_relax */
-    double *residual;            /* residual_n: f - K u after the last local relaxation (wedge_relax.c) */
+    double *residual;            /* residual_n: f - K u after the last local relaxation (wedge/relax.c) */
     int32_t residual_n;
     bool residual_valid;         /* residual still describes the model but for the rows of dirty_nodes;
                                     cleared by everything that moves the model except a cut */
@@ -199,17 +199,17 @@ typedef struct {
     int64_t fractures;           /* elements removed so far, or node splits (fracture.method = split) */
     fs_wedge_counters counters;
 
-    /* Element splitting (wedge_split.c, thesis §5.7.3): the crack tips that may still extend. */
+    /* Element splitting (wedge/split.c, thesis §5.7.3): the crack tips that may still extend. */
     int32_t n_tips, cap_tips;
     int32_t *tip_node;           /* mesh node of each tip */
     double *tip_dir;             /* 3 per tip: unit direction the crack arrived in (model frame) */
     double *tip_scale;           /* per tip: factor on its coarse ratio, the last sub-model ratio over the
-                                    coarse ratio then (fracture.tip_submodel, wedge_tips.c), else 1 */
+                                    coarse ratio then (fracture.tip_submodel, wedge/tips.c), else 1 */
     double tips_unit;            /* mean edge length (cm) of the living elements at the first use of the
                                     sub-model or smoothing radius: their unit; 0 before */
     int64_t griffith_stops;      /* tips retired by the Griffith criterion */
     uint8_t *open;               /* per node: 1 on a boundary edge of the mesh (a crack wall, a tip,
-                                    the domain's border), while open_valid (wedge_split.c) */
+                                    the domain's border), while open_valid (wedge/split.c) */
     bool open_valid;             /* cleared by every change of the mesh's connectivity */
 } fs_wedge_model;
 
@@ -225,7 +225,7 @@ int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg);
 /* fs_wedge_init without the assembly: the node and element arrays are filled (materials, thickness
  * factors, prescribed values) but there is no system yet, so the caller may change them and must then
  * call fs_wedge_pin_top, which assembles and factorizes; nothing else may be called before. For
- * models built from another one's data (wedge_tips.c's sub-models). Returns 0 or -1 as fs_wedge_init. */
+ * models built from another one's data (wedge/tips.c's sub-models). Returns 0 or -1 as fs_wedge_init. */
 int fs_wedge_init_unassembled(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg);
 
 /* Releases everything the model owns (not the mesh) and zeroes it. */
@@ -373,7 +373,7 @@ int fs_wedge_update_geometry(fs_wedge_model *w, const int32_t *elems, int32_t n)
 double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e);
 
 /* One fracture event by element splitting at the current time (thesis §5.7, Algorithms 10-12; see
- * wedge_split.c): the crack tip with the largest nodal ratio over 1 extends, or if no tip is over its
+ * wedge/split.c): the crack tip with the largest nodal ratio over 1 extends, or if no tip is over its
  * threshold, a new crack starts at the node with the largest ratio over 1. With fracture.tip_submodel
  * the picked tip extends only if its sub-model ratio (fs_wedge_tip_submodel) is over 1 too, in the
  * sub-model's direction; otherwise its tip_scale drops it below 1 and the next tip is tried. With
@@ -407,7 +407,7 @@ int fs_wedge_refactor(fs_wedge_model *w);
  * or -1 with fs_error. */
 int fs_wedge_simulate(fs_wedge_model *w, double t_end);
 
-/* ---- §5.7.7-5.7.9: refinement, sub-models and smoothing around crack tips (wedge_tips.c) ---- */
+/* ---- §5.7.7-5.7.9: refinement, sub-models and smoothing around crack tips (wedge/tips.c) ---- */
 
 /* Von Mises discontinuity indicator of every node (thesis §5.7.7, Algorithm 13) at the current
  * stresses (stress_top, so the last equilibrium): the largest minus the smallest von Mises stress of
@@ -514,9 +514,9 @@ int fs_wedge_update_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n);
  * With fracture by splitting, the top surface at the in-plane displaced top-node positions (so the
  * cracks open) and a floor (height 0, crack 1, cell 0) exactly in the gaps between the fragments:
  * on the plane and cylinder the mesh partitions texture space, tops and floor meeting vertex to
- * vertex, so that the lift closes every crack with walls (wedge_render.c).
+ * vertex, so that the lift closes every crack with walls (wedge/surface.c).
  * Fragments are the connected components of living elements sharing a node. Returns 0 or -1. */
-int fs_wedge_render_mesh(const fs_wedge_model *w, fs_render_mesh *out);
+int fs_wedge_render_mesh(const fs_wedge_model *w, fs_surface *out);
 
 /* Fragment label of every element (-1 for removed ones, else 0 .. count-1 numbered by their smallest
  * element); returns the count. labels has n_elems entries. */
@@ -525,6 +525,6 @@ int32_t fs_wedge_fragments(const fs_wedge_model *w, int32_t *labels);
 /* The whole wedge run of fs_sim_run: model on mesh (refined in place by subdivision), simulation to
  * cfg->time.end, render mesh into surface; stats gets fractures and the simulated time (nodes,
  * elements and timings are the caller's). Returns 0 or -1 with fs_error. */
-int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, fs_stats *stats);
+int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_surface *surface, fs_stats *stats);
 
 #endif

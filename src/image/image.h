@@ -1,7 +1,7 @@
 /* Images: reading, atomic writing, comparison and distance transforms (C interface to OpenCV,
  * implemented in image.cpp, the only file that includes OpenCV). */
-#ifndef FS_IO_IMAGE_H
-#define FS_IO_IMAGE_H
+#ifndef FS_IMAGE_IMAGE_H
+#define FS_IMAGE_IMAGE_H
 
 #include <stdbool.h>
 #include <stddef.h>

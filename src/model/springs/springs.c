@@ -1,5 +1,5 @@
 /* The springs model: the mass-spring network of thesis ch. 4 on a mesh, growth and shrinkage, and fracture in time. */
-#include "model/springs.h"
+#include "model/springs/springs.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -11,7 +11,7 @@
 #include "base/vec.h"
 #include "fracture/event.h"
 #include "fracture/rank.h"
-#include "io/image.h"
+#include "image/image.h"
 
 /* ==== the springs model ==== */
 
@@ -677,7 +677,7 @@ int fs_springs_advance(fs_springs *s, double t_end)
 
 int fs_springs_run(const fs_mesh *m, const fs_springs_params *springs, const fs_material *material,
                    const fs_growth *growth, const fs_shrink *shrink, double time_end, double min_step,
-                   uint64_t seed, fs_render_mesh *surface, int64_t *fractures, double *simulated_time)
+                   uint64_t seed, fs_surface *surface, int64_t *fractures, double *simulated_time)
 {
     fs_springs_setup setup;
     memset(&setup, 0, sizeof setup);

@@ -1,5 +1,5 @@
 /* The 6-node wedge element of thesis §5.3: isoparametric shape functions, Table 5.1 quadrature, K, stresses. */
-#include "model/wedge_element.h"
+#include "model/wedge/element.h"
 
 #include <math.h>
 #include <string.h>

@@ -9,8 +9,8 @@
 #include "fracture/rank.h"
 #include "fracture/split.h"
 #include "geom/refine.h"
-#include "model/wedge.h"
-#include "model/wedge_frame.h"
+#include "model/wedge/wedge.h"
+#include "model/wedge/frame.h"
 
 /* design: thesis §5.7. The layer is a surface mesh extruded into wedge columns, and a crack always
  * cuts a whole column (the top and the bottom node of a mesh node together), so splitting is a 2-D
@@ -38,7 +38,7 @@
  * the crack with the unloaded walls behind it and misses the stress concentration that the thesis
  * resolves with a temporary finer mesh at the tip (§5.7.8); this model takes instead, at a tip, the
  * largest ratio (and its direction) among the top Gauss points nearest the tip, one per element: the
- * coarse estimate. With fracture.tip_submodel the thesis's sub-model (wedge_tips.c) decides for the
+ * coarse estimate. With fracture.tip_submodel the thesis's sub-model (wedge/tips.c) decides for the
  * tip about to extend, and calibrates that tip's estimate (see tip_submodel_check).
  *
  * Order (Fig. 5.20): tips first (largest ratio over 1 among tips), new cracks only when no tip is
@@ -59,7 +59,7 @@
  * ends there; the model relaxes and the criterion is evaluated again on the finer mesh.
  *
  * Smoothing (§5.7.9, mesh.smooth_radius): after a cut, the free nodes around the new tips are moved
- * by angle-based smoothing (fs_wedge_smooth, wedge_tips.c) before the model relaxes.
+ * by angle-based smoothing (fs_wedge_smooth, wedge/tips.c) before the model relaxes.
  *
  * The global system after a cut is updated in place for the changed elements (fs_wedge_apply_change)
  * and re-factorized; duplicated and new nodes start from the displacement of the nodes they came

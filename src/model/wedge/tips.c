@@ -9,8 +9,8 @@
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "geom/refine.h"
-#include "model/wedge.h"
-#include "model/wedge_frame.h"
+#include "model/wedge/wedge.h"
+#include "model/wedge/frame.h"
 
 /* Refinement passes of a sub-model around its tip (each bisects the tip's vicinity once, with
  * propagation); a bound, reached only with a tip_submodel_size far below the mesh. */

@@ -1,5 +1,5 @@
 /* The wedge model's layer: geometry and materials from the mesh, sparse assembly, equilibrium (CHOLMOD or CG) and element stresses. */
-#include "model/wedge.h"
+#include "model/wedge/wedge.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -13,8 +13,8 @@
 #include "fracture/eigen.h"
 #include "fracture/rank.h"
 #include "geom/refine.h"
-#include "io/image.h"
-#include "model/wedge_element.h"
+#include "image/image.h"
+#include "model/wedge/element.h"
 #include "solve/cg.h"
 
 /* Map factors are clamped to this floor so that a black pixel cannot make an element singular. */
@@ -1904,7 +1904,7 @@ int fs_wedge_refactor(fs_wedge_model *w)
     return factorize(w, false);
 }
 
-/* The rows of f - K u of these nodes changed (wedge_relax.c keeps the rest of the residual between
+/* The rows of f - K u of these nodes changed (wedge/relax.c keeps the rest of the residual between
  * events); nothing to record while there is no kept residual (global relaxation, or after anything
  * that invalidated it: the next fs_wedge_relax computes it in full). */
 static void mark_dirty(fs_wedge_model *w, const int32_t *nodes, int32_t nn)

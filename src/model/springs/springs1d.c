@@ -1,5 +1,5 @@
 /* The 1-D mass-spring chain of thesis Appendix A: exact equilibria, breaks in time, analytic solution. */
-#include "model/springs1d.h"
+#include "model/springs/springs1d.h"
 
 #include <math.h>
 #include <string.h>

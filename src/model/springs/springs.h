@@ -8,7 +8,7 @@
 #include "field/field.h"
 #include "field/growth.h"
 #include "geom/mesh.h"
-#include "render/render.h"
+#include "geom/surface.h"
 #include "solve/sparse.h"
 
 /* ==== Conventions ====
@@ -308,7 +308,7 @@ void fs_springs_direction(const fs_springs *s, int32_t spring, double dir[3]);
  * number of fragments. */
 int32_t fs_springs_fragments(const fs_springs *s, int32_t *label);
 
-/* design: the 3-D post-process of thesis §4.5 (Fig. 4.10), in springs_post.c. Every Voronoi cell
+/* design: the 3-D post-process of thesis §4.5 (Fig. 4.10), in springs/post.c. Every Voronoi cell
  * (circumcentres of its node's ring; on a non-periodic border closed by the midpoints of the border
  * edges and the node, snapped onto the domain's edge) is extruded through the layers: at each level
  * between layers there is a node at the cell's site and one at each polygon corner, and every
@@ -325,12 +325,12 @@ int32_t fs_springs_fragments(const fs_springs *s, int32_t *label);
  * the inverse background flow. The heights are real: cracks reach down to the glued level.
  * Sphere: triangles are unwrapped across the longitude seam and split at the poles.
  * Returns 0 or -1 with fs_error. */
-int fs_springs_render(const fs_springs *s, fs_render_mesh *out);
+int fs_springs_render(const fs_springs *s, fs_surface *out);
 
 /* The model run of one configuration (called by sim.c): init, advance to time_end, render.
  * fractures and simulated_time receive the break count and the time reached. */
 int fs_springs_run(const fs_mesh *m, const fs_springs_params *springs, const fs_material *material,
                    const fs_growth *growth, const fs_shrink *shrink, double time_end, double min_step,
-                   uint64_t seed, fs_render_mesh *surface, int64_t *fractures, double *simulated_time);
+                   uint64_t seed, fs_surface *surface, int64_t *fractures, double *simulated_time);
 
 #endif

@@ -1,5 +1,5 @@
 /* Image I/O, comparison, distance transform and resampling: the only file that uses OpenCV. */
-#include "io/image.h"
+#include "image/image.h"
 
 extern "C" {
 #include "base/error.h"

@@ -1,5 +1,5 @@
-/* Conforming refinement of triangles on the sphere into the equirectangular texture (render/sphere.h). */
-#include "render/sphere.h"
+/* Conforming refinement of triangles on the sphere into the equirectangular texture (geom/sphere_surface.h). */
+#include "geom/sphere_surface.h"
 
 #include <math.h>
 #include <stdbool.h>
@@ -97,7 +97,7 @@ static void emit_leaf(const fs_sphere_refiner *s, const point *a, const point *b
             u0 = uv[0];
         idx[k] = s->vertex(s->user, unwrap_near(uv[0], u0), uv[1], v[k]->w);
     }
-    fs_render_mesh_add_tri(s->out, idx[0], idx[1], idx[2]);
+    fs_surface_add_tri(s->out, idx[0], idx[1], idx[2]);
 }
 
 /* design: each edge is halved when split_edge says so, and a triangle is cut into 2, 3 or 4
@@ -208,8 +208,8 @@ static void emit_pole(const fs_sphere_refiner *s, int k, const point *x, const p
         for (int r = 0; r < rows; r++) {
             int32_t v00 = idx[j * (rows + 1) + r], v01 = idx[j * (rows + 1) + r + 1];
             int32_t v10 = idx[(j + 1) * (rows + 1) + r], v11 = idx[(j + 1) * (rows + 1) + r + 1];
-            fs_render_mesh_add_tri(s->out, v00, v10, v11);
-            fs_render_mesh_add_tri(s->out, v00, v11, v01);
+            fs_surface_add_tri(s->out, v00, v10, v11);
+            fs_surface_add_tri(s->out, v00, v11, v01);
         }
     free(idx);
     free(col);

@@ -1,11 +1,11 @@
 /* Conforming refinement of triangles on the sphere into the equirectangular texture, for render meshes. */
-#ifndef FS_RENDER_SPHERE_H
-#define FS_RENDER_SPHERE_H
+#ifndef FS_GEOM_SPHERE_SURFACE_H
+#define FS_GEOM_SPHERE_SURFACE_H
 
 #include <stdint.h>
 
 #include "geom/domain.h"
-#include "render/render.h"
+#include "geom/surface.h"
 
 /* Where the pieces of a refined triangle go, and how finely it is cut. */
 typedef struct {
@@ -14,7 +14,7 @@ typedef struct {
                               * ends' images before the chord is halved, falling to a quarter of it
                               * over the 7.5 % of the texture height next to each pole; chords
                               * shorter than 1e-3 radii are not halved */
-    fs_render_mesh *out;     /* the triangles are appended to it */
+    fs_surface *out;     /* the triangles are appended to it */
     /* Appends to out a vertex at texture point (u, v) whose attributes are w[0] A + w[1] B + w[2] C
      * for the corners A, B, C of the triangle being refined (the weights are >= 0 and sum to 1; the
      * caller mixes its attributes as it likes), and returns its index. */

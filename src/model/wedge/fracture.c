@@ -8,7 +8,7 @@
 #include "fracture/event.h"
 #include "fracture/rank.h"
 #include "geom/refine.h"
-#include "model/wedge.h"
+#include "model/wedge/wedge.h"
 
 /* Candidates of one subdivision batch, sorted by descending ratio, then ascending index. */
 typedef struct {
@@ -119,7 +119,7 @@ static void report(const fs_wedge_model *w, double t_end)
  * is over its threshold, fs_event_find advances to just past the next time something is (within
  * time.min_step), starting with a step of half the time since the previous event. */
 /* Adaptive refinement by von Mises discontinuity (thesis §5.7.7, Algorithm 13) after an equilibrium at
- * a new time, when mesh.refine_vm is set (wedge_tips.c). Returns 0 or -1. */
+ * a new time, when mesh.refine_vm is set (wedge/tips.c). Returns 0 or -1. */
 static int refine_at_new_time(fs_wedge_model *w)
 {
     if (!(w->cfg.mesh.refine_vm > 0.0))
@@ -193,7 +193,7 @@ done:
     return rc < 0 ? -1 : 0;
 }
 
-int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_render_mesh *surface, fs_stats *stats)
+int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_surface *surface, fs_stats *stats)
 {
     fs_wedge_model w;
     if (fs_wedge_init(&w, mesh, cfg) < 0)

@@ -1,5 +1,5 @@
 /* The springs model's 3-D post-process (thesis §4.5, Fig. 4.10): extruded cells relaxed as spring sub-networks, drawn into a render mesh. */
-#include "model/springs.h"
+#include "model/springs/springs.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -802,13 +802,13 @@ typedef struct {
 
 static double wrap_near(double u, double ref) { return u - floor(u - ref + 0.5); }
 
-static void put_vertex(fs_render_mesh *out, double u, double v, double h, const emit_vertex *e)
+static void put_vertex(fs_surface *out, double u, double v, double h, const emit_vertex *e)
 {
-    fs_render_mesh_add_vertex(out, u, v, h > 0.0 ? h : 0.0, e->crack, e->cell, e->shade);
+    fs_surface_add_vertex(out, u, v, h > 0.0 ? h : 0.0, e->crack, e->cell, e->shade);
 }
 
 /* A triangle of the sphere containing a pole: three columns from its edges to the pole's row. */
-static bool emit_pole(const post_ctx *c, fs_render_mesh *out, const emit_vertex *v[3])
+static bool emit_pole(const post_ctx *c, fs_surface *out, const emit_vertex *v[3])
 {
     for (int pole = 0; pole < 2; pole++) {
         double P[3] = {0.0, 0.0, pole ? 1.0 : -1.0};
@@ -848,8 +848,8 @@ static bool emit_pole(const post_ctx *c, fs_render_mesh *out, const emit_vertex 
             }
             for (int j = 0; j < steps; j++) {
                 int32_t i0 = base + 2 * j;
-                fs_render_mesh_add_tri(out, i0, i0 + 2, i0 + 3);
-                fs_render_mesh_add_tri(out, i0, i0 + 3, i0 + 1);
+                fs_surface_add_tri(out, i0, i0 + 2, i0 + 3);
+                fs_surface_add_tri(out, i0, i0 + 3, i0 + 1);
             }
         }
         return true;
@@ -857,7 +857,7 @@ static bool emit_pole(const post_ctx *c, fs_render_mesh *out, const emit_vertex 
     return false;
 }
 
-static void emit_tri(const post_ctx *c, fs_render_mesh *out, const emit_vertex *a, const emit_vertex *b,
+static void emit_tri(const post_ctx *c, fs_surface *out, const emit_vertex *a, const emit_vertex *b,
                      const emit_vertex *d, int depth, bool face)
 {
     const emit_vertex *v[3] = {a, b, d};
@@ -892,7 +892,7 @@ static void emit_tri(const post_ctx *c, fs_render_mesh *out, const emit_vertex *
     int32_t base = out->n_verts;
     for (int k = 0; k < 3; k++)
         put_vertex(out, uv[k][0], uv[k][1], h[k], v[k]);
-    fs_render_mesh_add_tri(out, base, base + 1, base + 2);
+    fs_surface_add_tri(out, base, base + 1, base + 2);
 }
 
 /* Position of post node p seen from a cell, with the offset. */
@@ -942,7 +942,7 @@ static double uv_area2(const double *a, const double *b, const double *d)
  * cylinder) is instead cut into ears of its corner polygon, the centre splitting the ear that holds
  * it (or left out if it lies outside the polygon). Returns true if the fan is fine and nothing was
  * emitted; false when the top was emitted here. */
-static bool emit_top_folded(const post_ctx *c, fs_render_mesh *out, const emit_vertex *centre, const emit_vertex *ring,
+static bool emit_top_folded(const post_ctx *c, fs_surface *out, const emit_vertex *centre, const emit_vertex *ring,
                             int32_t nk)
 {
     if (c->sphere || nk > 64)
@@ -1005,7 +1005,7 @@ static bool emit_top_folded(const post_ctx *c, fs_render_mesh *out, const emit_v
     return false;
 }
 
-static void emit(const post_ctx *c, const fs_spring_net *net, fs_render_mesh *out)
+static void emit(const post_ctx *c, const fs_spring_net *net, fs_surface *out)
 {
     const fs_springs *s = c->s;
     int32_t n = s->n;
@@ -1063,7 +1063,7 @@ static void emit(const post_ctx *c, const fs_spring_net *net, fs_render_mesh *ou
     free(label);
 }
 
-int fs_springs_render(const fs_springs *s, fs_render_mesh *out)
+int fs_springs_render(const fs_springs *s, fs_surface *out)
 {
     post_ctx c;
     memset(&c, 0, sizeof c);

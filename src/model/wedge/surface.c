@@ -7,11 +7,11 @@
 #include "base/log.h"
 #include "base/rng.h"
 #include "base/vec.h"
-#include "model/wedge.h"
-#include "render/sphere.h"
+#include "model/wedge/wedge.h"
+#include "geom/sphere_surface.h"
 
 /* Sphere: largest uv deviation of a chord's midpoint image from the mean of its ends' images
- * before the chord is halved (render/sphere.h). */
+ * before the chord is halved (geom/sphere_surface.h). */
 #define SPHERE_UV_TOLERANCE 5e-4
 
 static int32_t find_root(int32_t *parent, int32_t i)
@@ -73,9 +73,9 @@ static attr attr_mix(attr a, attr b, attr c, double wa, double wb, double wc)
     return r;
 }
 
-static int32_t add_vertex(fs_render_mesh *out, double u, double v, attr a)
+static int32_t add_vertex(fs_surface *out, double u, double v, attr a)
 {
-    return fs_render_mesh_add_vertex(out, u, v, a.height, a.crack, a.cell, a.shade);
+    return fs_surface_add_vertex(out, u, v, a.height, a.crack, a.cell, a.shade);
 }
 
 /* ---- the mesh ---- */
@@ -102,7 +102,7 @@ static void top_shift(const fs_wedge_model *w, int32_t node, double *p)
 
 typedef struct {
     const fs_wedge_model *w;
-    fs_render_mesh *out;
+    fs_surface *out;
     fs_sphere_refiner sphere; /* draws the triangles of a sphere (the frame is not flat) */
     const attr *sphere_attr;  /* the corners' attributes of the triangle it draws */
     double ext[2];   /* the unwrapped rectangle (flat frames) */
@@ -134,7 +134,7 @@ static void emit_tri(render_ctx *r, const double p[3][3], const attr a[3])
     int32_t v[3];
     for (int c = 0; c < 3; c++)
         v[c] = add_vertex(r->out, p[c][0] / r->ext[0], p[c][1] / r->ext[1], a[c]);
-    fs_render_mesh_add_tri(r->out, v[0], v[1], v[2]);
+    fs_surface_add_tri(r->out, v[0], v[1], v[2]);
 }
 
 static attr top_attr(const render_ctx *r, int32_t e, int32_t node)
@@ -359,7 +359,7 @@ static int cmp_on_edge(const void *x, const void *y)
 /* Where rest point x lies along the rest wall edge from a to b: its parameter t, and *off, its
  * distance from the edge. Flat frames: the foot of x on the segment. Sphere: the edge is the arc of
  * the great circle through a and b, since the nodes that split an edge are projected onto the
- * sphere (wedge_split.c); t is where the ray to x meets the chord, *off the distance of x from the
+ * sphere (wedge/split.c); t is where the ray to x meets the chord, *off the distance of x from the
  * plane of the great circle (or infinite when x is on the far side of the sphere). */
 static double edge_param(const render_ctx *r, const double *a, const double *b, const double *x, double *off)
 {
@@ -880,7 +880,7 @@ static int32_t close_crossings(render_ctx *r, wall_point *pts, int32_t n_pts, co
     return joined;
 }
 
-/* design: with fracture by splitting (wedge_split.c) every element stays alive and a crack is a pair
+/* design: with fracture by splitting (wedge/split.c) every element stays alive and a crack is a pair
  * of walls, boundary edges of the surface mesh on nodes duplicated at one rest position, which the
  * in-plane displacement of the top nodes opens. The render mesh must partition texture space (the
  * lift of render.h closes steps between neighbouring surfaces), so it holds the fragment tops at
@@ -898,7 +898,7 @@ static int32_t close_crossings(render_ctx *r, wall_point *pts, int32_t n_pts, co
  *  - crossings of walls where a crack is pressed shut are resolved first (close_crossings).
  * Texture maps do not change except where walls cross: the floor has the attributes of the exposed
  * background. On the sphere the same mesh is drawn in 3-D and each triangle is refined into the
- * texture by fs_sphere_triangle (render/sphere.h), which cuts a shared chord at the same points on
+ * texture by fs_sphere_triangle (geom/sphere_surface.h), which cuts a shared chord at the same points on
  * both sides, so tops and floor still meet vertex to vertex and the lift is closed. A wall edge there
  * is an arc of a great circle, not its chord: the nodes that split an edge lie on the sphere
  * (points_on_edge, edge_param). */
@@ -1067,7 +1067,7 @@ static int split_render_mesh(render_ctx *r)
     return 0;
 }
 
-int fs_wedge_render_mesh(const fs_wedge_model *w, fs_render_mesh *out)
+int fs_wedge_render_mesh(const fs_wedge_model *w, fs_surface *out)
 {
     memset(out, 0, sizeof *out);
     const fs_mesh *m = w->mesh;
