@@ -6,10 +6,11 @@
 
 #include "base/error.h"
 #include "check.h"
+#include "setup.h"
 #include "wedge_fixture.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 /* A bonded layer 0.2 cm thick, E = 10000 MPa, nu = 0.3, whose top shrinks twice as fast as its bottom. */
 static fs_config base_config(double size, fs_relax_mode relax)
@@ -88,8 +89,8 @@ static void pair_init_with(fs_mesh *m, fs_config ca, fs_wedge_model *a, fs_wedge
 {
     fs_config cb = ca;
     cb.solver.relax = FS_RELAX_GLOBAL;
-    CHECK(fs_wedge_init(a, m, &ca) == 0);
-    CHECK(fs_wedge_init(b, m, &cb) == 0);
+    CHECK(fs_wedge_init(a, m, SETUP(&ca)) == 0);
+    CHECK(fs_wedge_init(b, m, SETUP(&cb)) == 0);
     CHECK(fs_wedge_equilibrium(a, 1.0) == 0);
     CHECK(fs_wedge_equilibrium(b, 1.0) == 0);
 }
@@ -166,7 +167,7 @@ static void test_crack_is_barrier(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 800, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     CHECK(fs_wedge_equilibrium(&w, 1.0) == 0);
     const double x0 = 1.8, x1 = 2.2, radius = 1.5;
     int32_t seed = -1;
