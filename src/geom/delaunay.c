@@ -71,10 +71,12 @@ static int qhull_unmerged(qhT *qh, int dim, int32_t npts, double *coords, char *
  * without Qt's pass (qhull_unmerged), and its rare failures (a Qhull precision error, a facet that
  * is not a triangle, or a mesh our checks reject) fall back to the merging run. Sphere: "Qt"
  * convex hull, each triangle turned to agree with Qhull's outward normal. Returns triangles as point
- * indices (Delaunay triangles unoriented). */
+ * indices (Delaunay triangles unoriented); with dim 3 and delaunay, tetrahedra (4 indices each,
+ * unoriented). */
 static int run_qhull(int dim, int32_t npts, double *coords, bool delaunay, bool merge, int32_t **tri_out,
                      int64_t *ntri_out)
 {
+    const int nv = delaunay && dim == 3 ? 4 : 3; /* vertices per simplex */
     *tri_out = NULL;
     *ntri_out = 0;
     char *msg = NULL;
@@ -104,21 +106,21 @@ static int run_qhull(int dim, int32_t npts, double *coords, bool delaunay, bool 
         vertexT *vertex, **vertexp;
         /* one walk over the facet list (it is scattered in memory): qh->num_facets bounds the count */
         int64_t count = qh->num_facets;
-        tri = fs_malloc((size_t)(count ? count : 1) * 3 * sizeof *tri);
+        tri = fs_malloc((size_t)(count ? count : 1) * nv * sizeof *tri);
         FORALLfacets {
             if (delaunay && facet->upperdelaunay)
                 continue;
-            int ids[3] = {-1, -1, -1}, k = 0;
+            int ids[4] = {-1, -1, -1, -1}, k = 0;
             bool inside = true;
             FOREACHvertex_(facet->vertices) {
                 int id = qh_pointid(qh, vertex->point);
-                if (k < 3)
+                if (k < nv)
                     ids[k] = id;
                 k++;
                 if (id < 0 || id >= npts)
                     inside = false;
             }
-            if (k != 3) {
+            if (k != nv) {
                 fs_error(FS_ERR_INTERNAL, "delaunay: qhull returned a facet with %d vertices %s", k,
                          unmerged ? "without merging" : "despite option Qt");
                 rc = -1;
@@ -145,9 +147,8 @@ static int run_qhull(int dim, int32_t npts, double *coords, bool delaunay, bool 
                     ids[2] = s;
                 }
             }
-            tri[3 * nt] = ids[0];
-            tri[3 * nt + 1] = ids[1];
-            tri[3 * nt + 2] = ids[2];
+            for (int c = 0; c < nv; c++)
+                tri[nv * nt + c] = ids[c];
             nt++;
         }
     }
@@ -1058,5 +1059,124 @@ int fs_delaunay(const fs_domain *d, const fs_points *pts, fs_mesh *out)
     int rc = dom.type == FS_DOMAIN_SPHERE ? triangulate_sphere(out) : triangulate_2d(out);
     if (rc != 0)
         fs_mesh_free(out);
+    return rc;
+}
+
+/* ---- 3-D Delaunay (tetrahedral layers) ---- */
+
+void fs_tets_free(fs_tets *t)
+{
+    free(t->tet);
+    free(t->shift);
+    memset(t, 0, sizeof *t);
+}
+
+/* design: the periodic 3-D triangulation follows the 2-D one (run_block): every point and its images
+ * across the wrapping sides within `margin` of the fundamental cell are triangulated together, a
+ * tetrahedron's corners are (node, image shift), its copies differ by a common shift, and the one copy
+ * whose smallest corner (node, then shift) has shift (0, 0) is kept. Without `merge` Qhull runs
+ * without facet merging first (see run_qhull; on layered points, whose layers make large flat hull
+ * faces, merging is twenty times slower), and with merging when that fails. Whether the margin was
+ * wide enough, and the result valid, is the caller's check (geom/tetmesh.c checks the faces and the volume and retries wider).
+ * Tetrahedra are turned positive; flat ones (zero volume, from cospherical ties) are kept, so that
+ * the faces still match, and left to the caller. */
+int fs_delaunay_tets(const double *pts, int32_t n, const double period[2], double margin, bool merge, fs_tets *out)
+{
+    memset(out, 0, sizeof *out);
+    if (n < 4 || !pts) {
+        fs_error(FS_ERR_DATA, "delaunay: %d points: a tetrahedral mesh needs at least 4", (int)n);
+        return -1;
+    }
+    for (int64_t k = 0; k < 3 * (int64_t)n; k++)
+        if (!isfinite(pts[k])) {
+            fs_error(FS_ERR_DATA, "delaunay: point %d has a coordinate that is not a finite number", (int)(k / 3));
+            return -1;
+        }
+    bool wraps[2] = {period[0] > 0.0, period[1] > 0.0};
+    int kr[2] = {wraps[0] ? 1 : 0, wraps[1] ? 1 : 0};
+    /* images: node and shift of each point fed to Qhull */
+    size_t cap = (size_t)n * (size_t)((2 * kr[0] + 1) * (2 * kr[1] + 1));
+    double *xyz = fs_malloc(3 * cap * sizeof *xyz);
+    int32_t *img_node = fs_malloc(cap * sizeof *img_node);
+    int8_t *img_shift = fs_malloc(2 * cap * sizeof *img_shift);
+    size_t count = 0;
+    for (int pass = 0; pass < 2; pass++) /* the originals first, so that ids below n are the nodes */
+        for (int32_t i = 0; i < n; i++)
+            for (int sx = -kr[0]; sx <= kr[0]; sx++)
+                for (int sy = -kr[1]; sy <= kr[1]; sy++) {
+                    bool original = sx == 0 && sy == 0;
+                    if (original != (pass == 0))
+                        continue;
+                    double p[3] = {pts[3 * (size_t)i] + sx * period[0], pts[3 * (size_t)i + 1] + sy * period[1],
+                                   pts[3 * (size_t)i + 2]};
+                    bool keep = true;
+                    for (int d = 0; d < 2; d++)
+                        if (wraps[d] && (p[d] < -margin || p[d] >= period[d] + margin))
+                            keep = false;
+                    if (!keep)
+                        continue;
+                    memcpy(xyz + 3 * count, p, sizeof p);
+                    img_node[count] = i;
+                    img_shift[2 * count] = (int8_t)sx;
+                    img_shift[2 * count + 1] = (int8_t)sy;
+                    count++;
+                }
+    int32_t *raw = NULL;
+    int64_t nraw = 0;
+    int rc = -1;
+    if (count > INT32_MAX)
+        fs_error(FS_ERR_DATA, "delaunay: %zu points with their periodic images are too many", count);
+    else if ((rc = run_qhull(3, (int32_t)count, xyz, true, merge, &raw, &nraw)) < 0 && !merge)
+        rc = run_qhull(3, (int32_t)count, xyz, true, true, &raw, &nraw);
+    if (rc == 0) {
+        out->tet = fs_malloc((size_t)(nraw ? nraw : 1) * 4 * sizeof *out->tet);
+        out->shift = fs_malloc((size_t)(nraw ? nraw : 1) * 8 * sizeof *out->shift);
+        int64_t kept = 0;
+        for (int64_t t = 0; t < nraw; t++) {
+            const int32_t *v = raw + 4 * t;
+            int first = 0;
+            for (int c = 1; c < 4; c++)
+                if (corner_less(img_node[v[c]], img_shift + 2 * (size_t)v[c], img_node[v[first]],
+                                    img_shift + 2 * (size_t)v[first]))
+                    first = c;
+            if (img_shift[2 * (size_t)v[first]] != 0 || img_shift[2 * (size_t)v[first] + 1] != 0)
+                continue;
+            int32_t *tv = out->tet + 4 * kept;
+            int8_t *ts = out->shift + 8 * kept;
+            for (int c = 0; c < 4; c++) {
+                tv[c] = img_node[v[c]];
+                ts[2 * c] = img_shift[2 * (size_t)v[c]];
+                ts[2 * c + 1] = img_shift[2 * (size_t)v[c] + 1];
+            }
+            const double *a = xyz + 3 * (size_t)v[0];
+            double e[3][3];
+            for (int c = 0; c < 3; c++)
+                fs_sub3(e[c], xyz + 3 * (size_t)v[c + 1], a);
+            double cr[3];
+            fs_cross3(cr, e[0], e[1]);
+            if (fs_dot3(cr, e[2]) < 0.0) {
+                int32_t sv = tv[2];
+                tv[2] = tv[3];
+                tv[3] = sv;
+                int8_t s0 = ts[4], s1 = ts[5];
+                ts[4] = ts[6];
+                ts[5] = ts[7];
+                ts[6] = s0;
+                ts[7] = s1;
+            }
+            kept++;
+        }
+        if (kept > INT32_MAX / 4) {
+            fs_error(FS_ERR_DATA, "delaunay: %lld tetrahedra are too many", (long long)kept);
+            fs_tets_free(out);
+            rc = -1;
+        } else {
+            out->n_tets = (int32_t)kept;
+        }
+    }
+    free(raw);
+    free(xyz);
+    free(img_node);
+    free(img_shift);
     return rc;
 }
