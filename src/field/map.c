@@ -30,6 +30,11 @@ double fs_grey_map_sample(const fs_grey_map *m, double u, double v)
     return top * (1.0 - ay) + bot * ay;
 }
 
+double fs_grey_map_factor(const fs_grey_map *m, double u, double v)
+{
+    return m->grey ? fmax(fs_grey_map_sample(m, u, v), FS_GREY_MAP_FLOOR) : 1.0;
+}
+
 void fs_grey_map_free(fs_grey_map *m)
 {
     free(m->grey);

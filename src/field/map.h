@@ -18,6 +18,11 @@ typedef struct {
  * 1 - (j + 1/2) / height; 1 for no map. */
 double fs_grey_map_sample(const fs_grey_map *m, double u, double v);
 
+/* A map as a factor scaling a material property (thesis §5.9): the sample at (u, v), but never below
+ * FS_GREY_MAP_FLOOR, so that a black pixel cannot make an element singular; 1 for no map. */
+#define FS_GREY_MAP_FLOOR 0.02
+double fs_grey_map_factor(const fs_grey_map *m, double u, double v);
+
 /* Frees the pixels and zeroes the map. */
 void fs_grey_map_free(fs_grey_map *m);
 

@@ -93,6 +93,13 @@ void fs_separation_tensor(const fs_separation *s, double zeta[6])
         zeta[k] = 0.5 * (-up[k] + s->m_plus[k] + um[k] - s->m_minus[k]);
 }
 
+int fs_separation_eigen(const double zeta[6], double values[3], double vectors[9])
+{
+    double a[9];
+    voigt_to_matrix(zeta, a);
+    return fs_eigen_sym3(a, values, vectors);
+}
+
 int fs_separation_largest(const double zeta[6], double *value, double normal[3])
 {
     double a[9], v[3], n[9];

@@ -39,6 +39,10 @@ void fs_separation_add(fs_separation *s, const double f_plus[3], const double f_
  * compression across a plane lowers it. It is invariant under rotations of the frame. */
 void fs_separation_tensor(const fs_separation *s, double zeta[6]);
 
+/* The eigenvalues of zeta (descending) and their unit eigenvectors (vectors + 3 k), as
+ * fs_eigen_sym3: fracture planes in order of preference. Returns 0 or -1 as fs_eigen_sym3. */
+int fs_separation_eigen(const double zeta[6], double values[3], double vectors[9]);
+
 /* The largest eigenvalue of zeta and its unit eigenvector (the normal of the fracture plane,
  * O'Brien & Hodgins §4.2), deterministic as fs_eigen_sym3's. Returns 0 or -1 as fs_eigen_sym3. */
 int fs_separation_largest(const double zeta[6], double *value, double normal[3]);

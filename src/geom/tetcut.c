@@ -208,6 +208,50 @@ static star_corner *find_corner(star_corner *cs, int32_t n, int32_t node)
     return NULL;
 }
 
+/* Classifies the corners of the elements at node (once each) against the plane through it with unit
+ * normal nrm, with the snapping of p, into cs (room for 3 per element); returns their number. */
+static int32_t classify(const fs_tetmesh *m, int32_t node, const double nrm[3], const fs_tetcut_params *p,
+                        star_corner *cs)
+{
+    double sin_snap = sin(p->snap_angle);
+    int32_t n_cs = 0;
+    const fs_tet_list *star = &m->node_tets[node];
+    for (int32_t k = 0; k < star->n; k++) {
+        int32_t t = star->v[k];
+        double x[12];
+        fs_tetmesh_corners(m, t, x);
+        int cn = corner_of(m, t, node);
+        for (int c = 0; c < 4; c++) {
+            int32_t v = m->tet[4 * (size_t)t + c];
+            if (c == cn || find_corner(cs, n_cs, v))
+                continue;
+            double r[3];
+            fs_sub3(r, x + 3 * c, x + 3 * cn);
+            double d = fs_dot3(r, nrm);
+            bool snapped = fabs(d) < p->snap_distance || fabs(d) < sin_snap * fs_norm3(r);
+            cs[n_cs++] = (star_corner){v, d, snapped || d == 0.0 ? 0 : (d > 0.0 ? 1 : -1)};
+        }
+    }
+    return n_cs;
+}
+
+int fs_tetcut_sides(const fs_tetmesh *m, int32_t node, const double normal[3], const fs_tetcut_params *p)
+{
+    double len = fs_norm3(normal);
+    if (!(len > 0.0) || !isfinite(len))
+        return 0;
+    double nrm[3] = {normal[0] / len, normal[1] / len, normal[2] / len};
+    int32_t cap = 3 * m->node_tets[node].n + 8;
+    star_corner buf[192], *cs = cap <= 192 ? buf : fs_malloc((size_t)cap * sizeof *cs);
+    int32_t n = classify(m, node, nrm, p, cs);
+    int sides = 0;
+    for (int32_t i = 0; i < n; i++)
+        sides |= cs[i].side > 0 ? 1 : (cs[i].side < 0 ? 2 : 0);
+    if (cs != buf)
+        free(cs);
+    return sides;
+}
+
 typedef struct {
     int32_t a, b;
     int8_t rel[2];
@@ -225,34 +269,18 @@ int fs_tetcut_node(fs_tetmesh *m, int32_t node, const double normal[3], const fs
         return -1;
     }
     double nrm[3] = {normal[0] / len, normal[1] / len, normal[2] / len};
-    double sin_snap = sin(p->snap_angle);
 
     /* classify the corners of the star */
     fs_tet_list star = {0};
     for (int32_t k = 0; k < m->node_tets[node].n; k++)
         fs_tet_list_push(&star, m->node_tets[node].v[k]);
-    int32_t n_cs = 0, cap_cs = 4 * star.n + 8;
+    int32_t cap_cs = 4 * star.n + 8;
     star_corner *cs = fs_malloc((size_t)cap_cs * sizeof *cs);
-    bool any_plus = false, any_minus = false;
-    for (int32_t k = 0; k < star.n; k++) {
-        int32_t t = star.v[k];
-        double x[12];
-        fs_tetmesh_corners(m, t, x);
-        int cn = corner_of(m, t, node);
-        for (int c = 0; c < 4; c++) {
-            int32_t v = m->tet[4 * (size_t)t + c];
-            if (c == cn || find_corner(cs, n_cs, v))
-                continue;
-            double r[3];
-            fs_sub3(r, x + 3 * c, x + 3 * cn);
-            double d = fs_dot3(r, nrm);
-            bool snapped = fabs(d) < p->snap_distance || fabs(d) < sin_snap * fs_norm3(r);
-            cs[n_cs++] = (star_corner){v, d, snapped || d == 0.0 ? 0 : (d > 0.0 ? 1 : -1)};
-            any_plus = any_plus || cs[n_cs - 1].side > 0;
-            any_minus = any_minus || cs[n_cs - 1].side < 0;
-        }
-    }
-    if (!any_plus || !any_minus) {
+    int32_t n_cs = classify(m, node, nrm, p, cs);
+    int sides = 0;
+    for (int32_t i = 0; i < n_cs; i++)
+        sides |= cs[i].side > 0 ? 1 : (cs[i].side < 0 ? 2 : 0);
+    if (sides != 3) {
         free(cs);
         fs_tet_list_free(&star);
         return 0;

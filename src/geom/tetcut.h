@@ -49,6 +49,11 @@ void fs_tetcut_result_free(fs_tetcut_result *r);
 int fs_tetcut_node(fs_tetmesh *m, int32_t node, const double normal[3], const fs_tetcut_params *p,
                    fs_tetcut_result *out);
 
+/* Which sides of the plane through `node` with the given normal the corners of its elements lie on,
+ * with the snapping above: bit 0 set when some corner is strictly on the positive side, bit 1 when
+ * some is on the negative side. fs_tetcut_node splits the node exactly when both are set (3). */
+int fs_tetcut_sides(const fs_tetmesh *m, int32_t node, const double normal[3], const fs_tetcut_params *p);
+
 /* Splits the edge from a to b (b's shift relative to a's given by rel, 2 values) at (1 - w) a + w b,
  * 0 < w < 1: one new node, each tetrahedron around the edge replaced by its two halves. Records
  * into out (which it does not empty) as fs_tetcut_node. Returns the new node. */

@@ -59,7 +59,7 @@ typedef struct {
 
 static const char *const section_names[] = {"preset", "domain", "mesh", "material", "growth",
                                             "shrink", "fracture", "time", "render", "voronoi", "solver",
-                                            "wedge", "springs", NULL};
+                                            "wedge", "springs", "tet", NULL};
 static const char *const model_words[] = {"voronoi", "springs", "wedge", "shell", "tet", NULL};
 static const char *const domain_words[] = {"plane", "cylinder", "sphere", NULL};
 static const char *const periodic_words[] = {"none", "x", "y", "xy", NULL};
@@ -162,6 +162,12 @@ static const key_def key_table[] = {
     {"springs", "max_breaks", KEY_INT, OFF(springs.max_breaks), 0, 2000000000, GE | LE, NULL, NULL},
     {"springs", "post", KEY_WORD, OFF(springs.post), 0, 0, 0, post_words, NULL},
     {"springs", "peel", KEY_REAL, OFF(springs.peel), 0, 0, GE, NULL, "cm"},
+
+    {"tet", "layers", KEY_INT, OFF(tet.layers), 0, 64, GE | LE, NULL, NULL},
+    {"tet", "snap_distance", KEY_REAL, OFF(tet.snap_distance), 0, 0.45, GE | LE, NULL, "edge lengths"},
+    {"tet", "snap_angle", KEY_REAL, OFF(tet.snap_angle), 0, 30, GE | LE, NULL, "degrees"},
+    {"tet", "bond", KEY_REAL, OFF(tet.bond), 0, 0, GE, NULL, "kPa"},
+    {"tet", "max_events", KEY_INT, OFF(tet.max_events), 0, 2000000000, GE | LE, NULL, NULL},
 };
 
 #define N_KEYS ((int)(sizeof key_table / sizeof key_table[0]))

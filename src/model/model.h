@@ -10,6 +10,7 @@
 #include "geom/surface.h"
 #include "model/params.h"
 #include "model/springs/springs.h"
+#include "model/tet/tet.h"
 #include "model/voronoi.h"
 #include "model/wedge/wedge.h"
 
@@ -78,6 +79,7 @@ struct fs_model_setup {
     fs_voronoi_params voronoi;
     fs_springs_params springs;
     fs_wedge_params wedge;
+    fs_tet_params tet;
 };
 typedef struct fs_model_setup fs_model_setup;
 
@@ -92,6 +94,7 @@ typedef struct {
     union {
         fs_springs *springs;
         fs_wedge_model *wedge;
+        fs_tet *tet;
     } state;                      /* the kind's state; voronoi has none */
 } fs_model;
 

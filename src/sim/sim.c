@@ -14,8 +14,10 @@
 /* Points for the mesh: particle repulsion, or the hexagonal lattice. */
 static int sample_points(const fs_config *cfg, fs_points *pts)
 {
-    /* the wedge model counts triangles (wedges): a Delaunay mesh has about two per point */
-    int32_t count = cfg->preset.model == FS_MODEL_WEDGE ? cfg->mesh.elements / 2 : cfg->mesh.elements;
+    /* the wedge model counts triangles (wedges), the tet model those of its top surface: a Delaunay
+     * mesh has about two per point */
+    bool triangles = cfg->preset.model == FS_MODEL_WEDGE || cfg->preset.model == FS_MODEL_TET;
+    int32_t count = triangles ? cfg->mesh.elements / 2 : cfg->mesh.elements;
     if (cfg->mesh.lattice == FS_LATTICE_HEX)
         return fs_sample_hex(&cfg->domain, count, pts);
     fs_sample_params sp = fs_sample_params_default();

@@ -361,7 +361,19 @@ static void apply_blas_threads(void)
     }
 }
 
+static fs_cholesky *analyze(const fs_sparse_matrix *a, bool small);
+
 fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a)
+{
+    return analyze(a, false);
+}
+
+fs_cholesky *fs_cholesky_analyze_small(const fs_sparse_matrix *a)
+{
+    return analyze(a, true);
+}
+
+static fs_cholesky *analyze(const fs_sparse_matrix *a, bool small)
 {
     apply_blas_threads();
     fs_cholesky *c = fs_calloc(1, sizeof *c);
@@ -383,6 +395,12 @@ fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a)
      * elimination tree, whose short paths make the rank updates after removals ~30 % cheaper
      * (bench_wedge), for a few tens of ms more per analysis. */
     c->common.nmethods = 3;
+    if (small) {
+        /* fs_cholesky_analyze_small: AMD alone, and a simplicial factor (no BLAS calls) */
+        c->common.nmethods = 1;
+        c->common.method[0].ordering = CHOLMOD_AMD;
+        c->common.supernodal = CHOLMOD_SIMPLICIAL;
+    }
     c->n = a->n;
     c->nnz = fs_sparse_matrix_nnz(a);
 

@@ -105,6 +105,12 @@ typedef struct {
  * large for 32-bit indices). */
 fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a);
 
+/* fs_cholesky_analyze for a small system factored once or a few times (a local relaxation): AMD alone
+ * and a simplicial factor. Below a few thousand unknowns that is several times faster: METIS's
+ * analysis costs more than it saves there, and the supernodal factor's many small BLAS calls hand
+ * work to the BLAS's threads and back. Results as fs_cholesky_analyze's up to rounding. */
+fs_cholesky *fs_cholesky_analyze_small(const fs_sparse_matrix *a);
+
 /* Numerically factorizes a with its current values. a must have the pattern given to
  * fs_cholesky_analyze (same n and entry count are checked with FS_ASSERT; the pattern itself is the
  * caller's contract). Call again after rewriting a->values to refactorize cheaply: the ordering and the

@@ -1,0 +1,126 @@
+/* The tetrahedral model's render surface: its top and crack walls in texture space, from the displaced 3-D layer. */
+#include "model/tet/internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "base/rng.h"
+#include "base/vec.h"
+#include "geom/sphere_surface.h"
+
+/* Where a face goes: top (crack 0, the fragment's cell) or wall (crack 1, cell 0). */
+typedef enum { FACE_HIDDEN = 0, FACE_TOP, FACE_WALL } face_kind;
+
+/* A face held by one element: on the substrate (all corners zeta 0: hidden below the layer), on a
+ * side of a plane that does not wrap (every corner on a side: the tile's edge, not a crack), on the
+ * top (all corners zeta 1, facing up), or a crack wall. */
+static face_kind classify(const fs_tet *s, int32_t t, int f)
+{
+    const fs_tetmesh *m = &s->mesh;
+    const int *fc = fs_tet_face[f];
+    int bottom = 0, top = 0, side = 0;
+    double ex = fs_domain_extent_x(&m->domain), ey = fs_domain_extent_y(&m->domain);
+    for (int k = 0; k < 3; k++) {
+        int32_t v = m->tet[4 * (size_t)t + fc[k]];
+        const double *p = m->pos + 3 * (size_t)v;
+        bottom += m->zeta[v] == 0.0;
+        top += m->zeta[v] == 1.0;
+        if (m->domain.type != FS_DOMAIN_SPHERE)
+            side += (m->period[0] == 0.0 && (p[0] == 0.0 || p[0] == ex)) ||
+                    (m->period[1] == 0.0 && (p[1] == 0.0 || p[1] == ey));
+    }
+    if (bottom == 3 || side == 3)
+        return FACE_HIDDEN;
+    if (top == 3) {
+        double x[12], e1[3], e2[3], n[3], up[3], c[3] = {0, 0, 0};
+        fs_tetmesh_corners(m, t, x);
+        fs_sub3(e1, x + 3 * fc[1], x + 3 * fc[0]);
+        fs_sub3(e2, x + 3 * fc[2], x + 3 * fc[0]);
+        fs_cross3(n, e1, e2);
+        if (m->domain.type == FS_DOMAIN_SPHERE) {
+            for (int k = 0; k < 3; k++)
+                c[k] = x[3 * fc[0] + k];
+            double r = fs_norm3(c);
+            for (int k = 0; k < 3; k++)
+                up[k] = c[k] / r;
+        } else {
+            up[0] = up[1] = 0.0;
+            up[2] = 1.0;
+        }
+        return fs_dot3(n, up) > 0.0 ? FACE_TOP : FACE_HIDDEN;
+    }
+    return FACE_WALL;
+}
+
+/* The substrate's radius along direction d (unit) on the growing sphere at time t. */
+static double substrate_radius(const fs_tet *s, const double d[3])
+{
+    double a = fs_growth_radius(&s->growth, s->time), c = fs_growth_radius_z(&s->growth, s->time);
+    return 1.0 / sqrt((d[0] * d[0] + d[1] * d[1]) / (a * a) + d[2] * d[2] / (c * c));
+}
+
+typedef struct {
+    fs_surface *out;
+    double height[3], crack, cell, shade;
+} sphere_face;
+
+static int32_t sphere_vertex(void *user, double u, double v, const double w[3])
+{
+    sphere_face *f = user;
+    double h = w[0] * f->height[0] + w[1] * f->height[1] + w[2] * f->height[2];
+    return fs_surface_add_vertex(f->out, u, v, h, f->crack, f->cell, f->shade);
+}
+
+int fs_tet_surface(const fs_tet *s, fs_surface *out)
+{
+    const fs_tetmesh *m = &s->mesh;
+    double c[FS_TET_LOADS];
+    fs_tet_coefficients(s, s->time, c);
+    int32_t *adj = fs_malloc((4 * (size_t)m->n_tets + 1) * sizeof *adj);
+    int32_t *comp = fs_malloc(((size_t)m->n_tets + 1) * sizeof *comp);
+    fs_tetmesh_adjacency(m, adj);
+    fs_tetmesh_components(m, adj, comp);
+    bool sphere = m->domain.type == FS_DOMAIN_SPHERE;
+    double ex = fs_domain_extent_x(&m->domain), ey = fs_domain_extent_y(&m->domain);
+    fs_sphere_refiner refiner = {&m->domain, 2e-3, out, sphere_vertex, NULL};
+    for (int32_t h = 0; h < 4 * m->n_tets; h++) {
+        if (adj[h] >= 0)
+            continue;
+        int32_t t = h / 4;
+        face_kind kind = classify(s, t, h % 4);
+        if (kind == FACE_HIDDEN)
+            continue;
+        double cell = kind == FACE_TOP ? (double)(comp[t] % 65535 + 1) : 0.0;
+        double shade = kind == FACE_TOP ? fs_rand_range(s->cfg.seed, FS_RNG_CELL_COLOR, (uint64_t)comp[t], -1.0, 1.0)
+                                        : 0.0;
+        double crack = kind == FACE_WALL ? 1.0 : 0.0;
+        const int *fc = fs_tet_face[h % 4];
+        double p[3][3];
+        for (int k = 0; k < 3; k++) {
+            double u[3];
+            fs_tetmesh_corner(m, t, fc[k], p[k]);
+            fs_tet_displacement(s, m->tet[4 * (size_t)t + fc[k]], c, u);
+            for (int a = 0; a < 3; a++)
+                p[k][a] += u[a];
+        }
+        if (sphere) {
+            sphere_face f = {out, {0, 0, 0}, crack, cell, shade};
+            for (int k = 0; k < 3; k++) {
+                double r = fs_norm3(p[k]), d[3] = {p[k][0] / r, p[k][1] / r, p[k][2] / r};
+                f.height[k] = r - substrate_radius(s, d);
+            }
+            refiner.user = &f;
+            fs_sphere_triangle(&refiner, p[0], p[1], p[2]);
+            continue;
+        }
+        int32_t v[3];
+        for (int k = 0; k < 3; k++)
+            v[k] = fs_surface_add_vertex(out, p[k][0] / ex, p[k][1] / ey, p[k][2], crack, cell, shade);
+        fs_surface_add_tri(out, v[0], v[1], v[2]);
+    }
+    free(adj);
+    free(comp);
+    return 0;
+}
