@@ -6,13 +6,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "base/error.h"
 #include "base/log.h"
 #include "base/threads.h"
 #include "cli/cli.h"
 #include "config.h"
-#include "io/obj.h"
+#include "io/asset.h"
 #include "io/output.h"
 #include "io/preset.h"
 #include "io/sidecar.h"
@@ -45,13 +46,15 @@ typedef struct {
     fs_normal_convention normal;
     bool list_presets, dump_preset;
     fs_target target;      /* --target: the engine the maps are named, packed and oriented for */
+    bool have_target;
     const char *mesh_path; /* --mesh FILE: the lifted 3-D layer as Wavefront OBJ, or NULL */
+    const char *asset_path; /* --asset FILE: the layer and its material as glTF (.gltf or .glb), or NULL */
     bool have_maps;        /* --maps was given (it also picks the frames' maps) */
     int32_t frames;        /* --frames N: time-lapse frames, 0 for none */
 } options;
 
 enum {
-    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET, OPT_FRAMES
+    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET, OPT_FRAMES, OPT_ASSET
 };
 
 /* Most time-lapse frames one run writes. */
@@ -72,6 +75,7 @@ static const struct option long_options[] = {
     {"list-presets", no_argument, NULL, OPT_LIST},
     {"dump-preset", no_argument, NULL, OPT_DUMP},
     {"mesh", required_argument, NULL, OPT_MESH},
+    {"asset", required_argument, NULL, OPT_ASSET},
     {"frames", required_argument, NULL, OPT_FRAMES},
     {"threads", required_argument, NULL, 'j'},
     {"help", no_argument, NULL, 'h'},
@@ -100,7 +104,11 @@ static void print_help(FILE *out)
           "                          normal map convention (default: opengl, +Y up)\n"
           "      --target ENGINE     name, pack and orient the maps for generic (default), gltf,\n"
           "                          unreal, unity-hdrp or blender\n"
-          "      --mesh FILE         also write the cracked 3-D layer to FILE as Wavefront OBJ\n"
+          "      --mesh FILE         also write the cracked 3-D layer to FILE as Wavefront OBJ, with its\n"
+          "                          material (the maps bound) in FILE.mtl\n"
+          "      --asset FILE        also write the layer and a PBR material binding the maps as a glTF\n"
+          "                          2.0 asset: FILE.gltf (with FILE.bin) or FILE.glb (images embedded);\n"
+          "                          implies --target gltf\n"
           "      --frames N          also write N time-lapse frames NAME_frame_0001_MAP.png ... of the\n"
           "                          crack growth (maps: those of --maps that are texture maps, else\n"
           "                          basecolor and crackmask; springs and wedge models only)\n"
@@ -219,7 +227,18 @@ static int parse_options(int argc, char **argv, options *o)
             if (fs_target_parse(optarg, &o->target) < 0)
                 return usage_error("--target: expected generic, gltf, unreal, unity-hdrp or blender, got '%s'",
                                    optarg);
+            o->have_target = true;
             break;
+        case OPT_ASSET: {
+            size_t n = strlen(optarg);
+            size_t stem = n > 5 && !strcasecmp(optarg + n - 5, ".gltf") ? n - 5
+                          : n > 4 && !strcasecmp(optarg + n - 4, ".glb") ? n - 4
+                                                                         : 0;
+            if (stem == 0 || optarg[stem - 1] == '/')
+                return usage_error("--asset: expected a file name ending in .gltf or .glb, got '%s'", optarg);
+            o->asset_path = optarg;
+            break;
+        }
         case OPT_FRAMES: {
             char *end;
             errno = 0;
@@ -255,6 +274,11 @@ static int parse_options(int argc, char **argv, options *o)
         default: fputs("Try 'fissure --help' for more information.\n", stderr); return FS_ERR_USAGE;
         }
     }
+    if (o->asset_path && o->have_target && o->target != FS_TARGET_GLTF)
+        return usage_error("--asset binds the maps as --target gltf writes them; it cannot be used with --target %s",
+                           fs_target_name(o->target));
+    if (o->asset_path)
+        o->target = FS_TARGET_GLTF;
     if (o->have_normal && fs_target_fixes_normal(o->target) && o->normal != fs_target_normal(o->target)) {
         char what[160];
         snprintf(what, sizeof what, "--normal %s conflicts with --target %s, whose normal maps are %s",
@@ -313,38 +337,6 @@ static int load_config(const char *arg, const options *o, fs_config *cfg, char *
     if (fs_target_fixes_normal(o->target))
         cfg->render.normal = fs_target_normal(o->target);
     return fs_preset_validate(cfg, *preset_path);
-}
-
-/* Lifts the result into 3-D and stages it as OBJ in the directory of path, which may lie outside
- * the output directory. Returns the staged output set, or NULL with fs_error. */
-static fs_output *stage_mesh(const char *path, const fs_config *cfg, const fs_result *res, const char *name)
-{
-    char *dir = fs_strdup(path);
-    char *slash = strrchr(dir, '/');
-    const char *file = slash ? path + (slash - dir) + 1 : path;
-    if (!slash)
-        strcpy(dir, ".");
-    else
-        slash[slash == dir ? 1 : 0] = '\0';
-    fs_output *out = fs_output_begin(dir);
-    free(dir);
-    if (!out)
-        return NULL;
-    fs_lifted_mesh lifted;
-    int rc = fs_render_lift(&res->surface, &cfg->domain, 1.0, &lifted);
-    if (rc == 0) {
-        char comment[200];
-        snprintf(comment, sizeof comment, "fissure %s: preset %s, seed %" PRIu64 ", %s model on a %s", PACKAGE_VERSION,
-                 cfg->preset.name, cfg->preset.seed, fs_model_name(cfg->preset.model),
-                 fs_domain_type_name(cfg->domain.type));
-        rc = fs_obj_write(fs_output_stage(out, file), &lifted, name, comment);
-    }
-    fs_lifted_mesh_free(&lifted);
-    if (rc < 0) {
-        fs_output_abort(out);
-        return NULL;
-    }
-    return out;
 }
 
 /* Map kinds a time-lapse frame can have: the texture-space rasters. */
@@ -503,9 +495,16 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
         rc = fs_target_write(out, o->target, name, kinds, n_kinds, &in, written);
     fs_image_free(&occlusion);
     fs_crackgraph_free(&cracks);
-    fs_output *mesh_out = NULL;
-    if (rc == 0 && o->mesh_path && !(mesh_out = stage_mesh(o->mesh_path, cfg, res, name)))
-        rc = -1;
+    fs_output *mesh_out = NULL, *asset_out = NULL;
+    fs_asset_inputs asset = {o->mesh_path, o->asset_path, &res->surface, cfg, name, o->output_dir, out,
+                             written->map, written->n, fs_target_name(o->target), maps->height_min_cm,
+                             maps->height_max_cm};
+    if (rc == 0)
+        rc = fs_asset_stage(&asset, &mesh_out, &asset_out);
+    const int n = written->n;
+    char asset_files[4][1024], asset_paths[4][1024];
+    int n_asset = rc == 0 ? fs_asset_files(&asset, written->map + n, asset_files, asset_paths) : 0;
+    written->n += n_asset;
     char json_name[600];
     snprintf(json_name, sizeof json_name, "%s.json", name);
     char frame_pattern[600];
@@ -517,23 +516,27 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
                               fs_target_name(o->target), written->map, written->n, o->frames ? &frames : NULL,
                               fs_seconds() - t_start);
     fs_target_output_free(written);
-    const int n = written->n;
     if (rc < 0) {
         free(written);
         fs_image_free(&exr_height);
         fs_output_abort(out);
-        if (mesh_out)
-            fs_output_abort(mesh_out);
+        fs_output_abort(mesh_out);
+        fs_output_abort(asset_out);
         return -1;
     }
     fs_image_free(&exr_height);
     if (fs_output_commit(out) < 0) {
         free(written);
-        if (mesh_out)
-            fs_output_abort(mesh_out);
+        fs_output_abort(mesh_out);
+        fs_output_abort(asset_out);
         return -1;
     }
     if (mesh_out && fs_output_commit(mesh_out) < 0) {
+        free(written);
+        fs_output_abort(asset_out);
+        return -1;
+    }
+    if (asset_out && fs_output_commit(asset_out) < 0) {
         free(written);
         return -1;
     }
@@ -549,8 +552,8 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
         printf("%s/%s\n", o->output_dir, written->file[i]);
     free(written);
     printf("%s/%s\n", o->output_dir, json_name);
-    if (o->mesh_path)
-        printf("%s\n", o->mesh_path);
+    for (int i = 0; i < n_asset; i++)
+        printf("%s\n", asset_paths[i]);
     return 0;
 }
 
