@@ -12,6 +12,7 @@
 #include "base/log.h"
 #include "base/threads.h"
 #include "cli/cli.h"
+#include "cli/jobs.h"
 #include "config.h"
 #include "io/asset.h"
 #include "io/output.h"
@@ -51,10 +52,13 @@ typedef struct {
     const char *asset_path; /* --asset FILE: the layer and its material as glTF (.gltf or .glb), or NULL */
     bool have_maps;        /* --maps was given (it also picks the frames' maps) */
     int32_t frames;        /* --frames N: time-lapse frames, 0 for none */
+    const char *job;       /* --job FILE:N: run job N of a jobs file (cli/jobs.h), or NULL */
+    const char *list_jobs; /* --list-jobs FILE */
 } options;
 
 enum {
-    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET, OPT_FRAMES, OPT_ASSET
+    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET, OPT_FRAMES, OPT_ASSET, OPT_JOB,
+    OPT_LIST_JOBS, OPT_PROGRESS
 };
 
 /* Most time-lapse frames one run writes. */
@@ -76,6 +80,9 @@ static const struct option long_options[] = {
     {"dump-preset", no_argument, NULL, OPT_DUMP},
     {"mesh", required_argument, NULL, OPT_MESH},
     {"asset", required_argument, NULL, OPT_ASSET},
+    {"job", required_argument, NULL, OPT_JOB},
+    {"list-jobs", required_argument, NULL, OPT_LIST_JOBS},
+    {"progress", required_argument, NULL, OPT_PROGRESS},
     {"frames", required_argument, NULL, OPT_FRAMES},
     {"threads", required_argument, NULL, 'j'},
     {"help", no_argument, NULL, 'h'},
@@ -86,6 +93,7 @@ static const struct option long_options[] = {
 static void print_help(FILE *out)
 {
     fputs("Usage: fissure [OPTION]... PRESET\n"
+          "       fissure [OPTION]... --job FILE:N\n"
           "       fissure diff [OPTION]... A B\n"
           "Grow a crack pattern by simulation and render it into texture maps.\n"
           "PRESET is a preset file, or the name of one found on the preset path.\n"
@@ -114,6 +122,12 @@ static void print_help(FILE *out)
           "                          basecolor and crackmask; springs and wedge models only)\n"
           "  -j, --threads N         run parallel work on at most N threads, 1 to 256, or 0 for one\n"
           "                          per processor (default); the results do not depend on N\n"
+          "      --job FILE:N        run job N (from 1) of the jobs file FILE, one job a line:\n"
+          "                          PRESET SEED NAME [SECTION.KEY=VALUE]... (see fissure(1))\n"
+          "      --list-jobs FILE    list the jobs of FILE, one a line, and exit\n"
+          "      --progress auto|json|none\n"
+          "                          progress on stderr: a line redrawn on a terminal (auto, the\n"
+          "                          default), one JSON object a line (json), or none\n"
           "  -q, --quiet             print nothing on stderr but errors\n"
           "  -v, --verbose           print details of each phase on stderr\n"
           "      --list-presets      list the presets on the preset path, one a line, and exit\n"
@@ -229,6 +243,15 @@ static int parse_options(int argc, char **argv, options *o)
                                    optarg);
             o->have_target = true;
             break;
+        case OPT_JOB: o->job = optarg; break;
+        case OPT_LIST_JOBS: o->list_jobs = optarg; break;
+        case OPT_PROGRESS:
+            if (strcmp(optarg, "auto") && strcmp(optarg, "json") && strcmp(optarg, "none"))
+                return usage_error("--progress: expected auto, json or none, got '%s'", optarg);
+            fs_progress_set_mode(!strcmp(optarg, "json")   ? FS_PROGRESS_JSON
+                                 : !strcmp(optarg, "none") ? FS_PROGRESS_NONE
+                                                           : FS_PROGRESS_AUTO);
+            break;
         case OPT_ASSET: {
             size_t n = strlen(optarg);
             size_t stem = n > 5 && !strcasecmp(optarg + n - 5, ".gltf") ? n - 5
@@ -291,7 +314,7 @@ static int parse_options(int argc, char **argv, options *o)
 
 static int fail(void)
 {
-    fs_progress_done();
+    fs_progress_end(0, fs_error_message());
     fprintf(stderr, "fissure: %s\n", fs_error_message());
     int status = fs_error_domain();
     return status == FS_OK ? FS_ERR_INTERNAL : status;
@@ -618,8 +641,38 @@ static int run(const char *preset_arg, const options *o)
     free(preset_text);
     if (rc < 0)
         return fail();
-    fs_info("done in %.1f s", fs_seconds() - t_start);
+    char done[64];
+    snprintf(done, sizeof done, "done in %.1f s", fs_seconds() - t_start);
+    fs_progress_end(1, done);
+    fs_info("%s", done);
     return 0;
+}
+
+/* --job FILE:N: the run `fissure [OPTION]... -s SEED -n NAME --set OVERRIDE... PRESET` of job N,
+ * the job's overrides after the command line's. */
+static int run_job(options *o, int n_args)
+{
+    if (n_args > 0)
+        return usage_error("%s", "--job: the job names its preset; expected no PRESET argument");
+    if (o->have_seed || o->name)
+        return usage_error("--job: the job sets %s; expected no --seed or --name beside it",
+                           o->have_seed ? "the seed" : "the output name");
+    fs_job job;
+    if (fs_job_load(o->job, &job) < 0) {
+        if (fs_error_domain() == FS_ERR_USAGE)
+            return usage_error("%s", fs_error_message());
+        return fail();
+    }
+    o->have_seed = true;
+    o->seed = job.seed;
+    o->name = job.name;
+    o->sets = fs_realloc(o->sets, (size_t)(o->n_sets + job.n_sets + 1) * sizeof *o->sets);
+    for (int k = 0; k < job.n_sets; k++)
+        o->sets[o->n_sets++] = job.sets[k];
+    fs_debug("%s: job on line %d", o->job, job.line);
+    int rc = run(job.preset, o);
+    fs_jobs_free(&job, 1);
+    return rc;
 }
 
 int main(int argc, char **argv)
@@ -638,6 +691,15 @@ int main(int argc, char **argv)
     if (o.list_presets) {
         free(o.sets);
         return fs_preset_list(stdout) < 0 ? fail() : 0;
+    }
+    if (o.list_jobs) {
+        free(o.sets);
+        return fs_jobs_list(o.list_jobs, stdout) < 0 ? fail() : 0;
+    }
+    if (o.job) {
+        rc = run_job(&o, argc - optind);
+        free(o.sets);
+        return rc;
     }
     if (optind != argc - 1) {
         free(o.sets);
