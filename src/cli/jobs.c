@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "base/error.h"
+#include "io/preset.h"
 
 /* Splits line into blank-separated fields, in place and into field[], or only counts them when
  * field is NULL; returns their count. */
@@ -112,9 +113,19 @@ static int parse_job(const char *path, const char *dir, int line, char **field, 
         return bad_line(path, line, "SEED: expected a non-negative integer", field[1]);
     if (strchr(field[2], '/'))
         return bad_line(path, line, "NAME: expected a file name prefix without '/'", field[2]);
-    for (int k = 3; k < n; k++)
+    for (int k = 3; k < n; k++) {
         if (!is_override(field[k]))
             return bad_line(path, line, "expected an override SECTION.KEY=VALUE", field[k]);
+        /* the key and the value's syntax, checked as --set checks them (ranges that depend on the
+         * preset are checked when the job runs) */
+        fs_config scratch = fs_config_default();
+        if (fs_preset_set(&scratch, field[k]) < 0) {
+            char *msg = fs_strdup(fs_error_message());
+            fs_error(FS_ERR_DATA, "%s:%d: %s", path, line, msg);
+            free(msg);
+            return -1;
+        }
+    }
     job->preset = resolve_preset(field[0], dir);
     job->name = fs_strdup(field[2]);
     job->n_sets = n - 3;

@@ -21,7 +21,8 @@ typedef struct {
  *     PRESET SEED NAME [SECTION.KEY=VALUE]...
  * Blank lines and lines whose first non-blank character is '#' are not jobs; jobs are numbered
  * from 1 in file order. SEED is a non-negative integer, NAME a file name prefix without '/' used
- * by no other job, each override has the form SECTION.KEY=VALUE (a value cannot hold blanks).
+ * by no other job, each override has the form SECTION.KEY=VALUE (a value cannot hold blanks) and
+ * names a preset key with a value of the right syntax, as --set checks them.
  * Every line is checked, so that every job of a bad file fails alike. Returns the number of jobs
  * (jobs allocated, fs_jobs_free frees them), or -1 with fs_error: FS_ERR_NOINPUT when the file
  * cannot be read, FS_ERR_DATA naming FILE:LINE and what was expected for a bad line or a file with
