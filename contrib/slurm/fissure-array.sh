@@ -5,11 +5,11 @@
 #     sbatch --array=1-$(fissure --list-jobs jobs.txt | wc -l) contrib/slurm/fissure-array.sh \
 #         jobs.txt -o out --size 2048x2048
 #
-# The arguments after the jobs file are fissure options common to every job (the output directory,
-# map size, --mesh or --asset paths are per job by nature: use them only through --set-free options
-# such as -o). Each task writes what the same run made alone would write, byte for byte (the
-# sidecar's wall-clock seconds aside), so tasks can run on any node in any order. FISSURE names the
-# binary (default: fissure on PATH); the task uses the CPUs Slurm gave it.
+# The arguments after the jobs file are fissure options common to every job: the output
+# directory, the map size, and --mesh or --asset paths with {name} in them (out/{name}.glb), which
+# the job's output name replaces. Each task writes what the same run made alone would write, byte
+# for byte (the sidecar's wall-clock seconds aside), so tasks can run on any node in any order.
+# FISSURE names the binary (default: fissure on PATH); a task runs on the CPUs Slurm gave it.
 #SBATCH --job-name=fissure
 #SBATCH --cpus-per-task=1
 #SBATCH --output=fissure-%A_%a.log

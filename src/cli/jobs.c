@@ -255,3 +255,22 @@ int fs_jobs_list(const char *path, FILE *out)
     free(jobs);
     return 0;
 }
+
+char *fs_job_expand_name(const char *pattern, const char *name)
+{
+    static const char key[] = "{name}";
+    size_t count = 0;
+    for (const char *p = strstr(pattern, key); p; p = strstr(p + 1, key))
+        count++;
+    char *out = fs_malloc(strlen(pattern) + count * strlen(name) + 1), *o = out;
+    for (const char *p = pattern; *p;) {
+        if (!strncmp(p, key, sizeof key - 1)) {
+            o += sprintf(o, "%s", name);
+            p += sizeof key - 1;
+        } else {
+            *o++ = *p++;
+        }
+    }
+    *o = '\0';
+    return out;
+}

@@ -39,4 +39,8 @@ int fs_job_load(const char *spec, fs_job *job);
  * line. Returns 0, or -1 with fs_error as fs_jobs_read. */
 int fs_jobs_list(const char *path, FILE *out);
 
+/* pattern with every "{name}" replaced by name (caller frees): --mesh and --asset paths of a batch,
+ * one file per job. */
+char *fs_job_expand_name(const char *pattern, const char *name);
+
 #endif

@@ -113,7 +113,8 @@ static void print_help(FILE *out)
           "      --target ENGINE     name, pack and orient the maps for generic (default), gltf,\n"
           "                          unreal, unity-hdrp or blender\n"
           "      --mesh FILE         also write the cracked 3-D layer to FILE as Wavefront OBJ, with its\n"
-          "                          material (the maps bound) in FILE.mtl\n"
+          "                          material (the maps bound) in FILE.mtl; {name} in FILE stands for\n"
+          "                          the output name (as in --asset)\n"
           "      --asset FILE        also write the layer and a PBR material binding the maps as a glTF\n"
           "                          2.0 asset: FILE.gltf (with FILE.bin) or FILE.glb (images embedded);\n"
           "                          implies --target gltf\n"
@@ -606,6 +607,14 @@ static int run(const char *preset_arg, const options *o)
             cfg.preset.seed, cfg.render.width, cfg.render.height);
     free(preset_path);
 
+    /* --mesh and --asset paths may hold {name}, for batches */
+    options named = *o;
+    char *mesh_path = o->mesh_path ? fs_job_expand_name(o->mesh_path, name) : NULL;
+    char *asset_path = o->asset_path ? fs_job_expand_name(o->asset_path, name) : NULL;
+    named.mesh_path = mesh_path;
+    named.asset_path = asset_path;
+    o = &named;
+
     fs_result res;
     fs_raster raster = {0};
     fs_maps maps = {0};
@@ -639,6 +648,8 @@ static int run(const char *preset_arg, const options *o)
     fs_raster_free(&raster);
     frame_writer_free(&fw);
     free(preset_text);
+    free(mesh_path);
+    free(asset_path);
     if (rc < 0)
         return fail();
     char done[64];
