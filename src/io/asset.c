@@ -147,17 +147,28 @@ static int write_mtl(const char *path, const fs_asset_inputs *in, const char *re
     return 0;
 }
 
-static fs_output *stage_mesh(const fs_asset_inputs *in, const fs_lifted_mesh *lifted)
+/* Begins an output set in the directory of path; *file is path's last component, *rel the way
+ * from that directory to the maps' (caller frees). NULL with fs_error on failure. */
+static fs_output *begin_beside(const char *path, const fs_asset_inputs *in, const char **file, char **rel)
 {
-    const char *file;
-    char *dir = dir_of(in->mesh_path, &file);
+    char *dir = dir_of(path, file);
     fs_output *out = fs_output_begin(dir);
-    char *rel = out ? relative_dir(dir, in->map_dir) : NULL;
+    *rel = out ? relative_dir(dir, in->map_dir) : NULL;
     free(dir);
-    if (!rel) {
+    if (!*rel) {
         fs_output_abort(out);
         return NULL;
     }
+    return out;
+}
+
+static fs_output *stage_mesh(const fs_asset_inputs *in, const fs_lifted_mesh *lifted)
+{
+    const char *file;
+    char *rel;
+    fs_output *out = begin_beside(in->mesh_path, in, &file, &rel);
+    if (!out)
+        return NULL;
     char *mtl = replace_ext(file, ".obj", NULL, ".mtl");
     char comment[200];
     lift_comment(in, comment, sizeof comment);
@@ -187,14 +198,10 @@ static fs_gltf_texture texture_of(const fs_asset_inputs *in, const char *kind, c
 static fs_output *stage_asset(const fs_asset_inputs *in, const fs_lifted_mesh *lifted)
 {
     const char *file;
-    char *dir = dir_of(in->asset_path, &file);
-    fs_output *out = fs_output_begin(dir);
-    char *rel = out ? relative_dir(dir, in->map_dir) : NULL;
-    free(dir);
-    if (!rel) {
-        fs_output_abort(out);
+    char *rel;
+    fs_output *out = begin_beside(in->asset_path, in, &file, &rel);
+    if (!out)
         return NULL;
-    }
     const fs_config *cfg = in->cfg;
     fs_domain d = cfg->domain;
     fs_domain_normalize(&d);
