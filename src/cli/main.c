@@ -47,7 +47,7 @@ typedef struct {
     fs_normal_convention normal;
     bool list_presets, dump_preset;
     fs_target target;      /* --target: the engine the maps are named, packed and oriented for */
-    bool have_target;
+    bool have_target;      /* --target was given (--asset accepts only gltf) */
     const char *mesh_path; /* --mesh FILE: the lifted 3-D layer as Wavefront OBJ, or NULL */
     const char *asset_path; /* --asset FILE: the layer and its material as glTF (.gltf or .glb), or NULL */
     bool have_maps;        /* --maps was given (it also picks the frames' maps) */
@@ -57,8 +57,8 @@ typedef struct {
 } options;
 
 enum {
-    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET, OPT_FRAMES, OPT_ASSET, OPT_JOB,
-    OPT_LIST_JOBS, OPT_PROGRESS
+    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET, OPT_FRAMES,
+    OPT_ASSET, OPT_JOB, OPT_LIST_JOBS, OPT_PROGRESS
 };
 
 /* Most time-lapse frames one run writes. */
