@@ -2,7 +2,8 @@
 # that the Khronos glTF validator passes with no error and no warning for every domain, whose
 # material binds the maps and whose tangents follow them (gltf_check.js); --mesh writes an OBJ with
 # an MTL binding the maps; Blender imports the .gltf, the .glb and the .obj, finds the material with
-# its textures bound and renders a frame of each (blender_check.py). Bad --asset requests fail
+# its textures bound and renders a frame of each, and Blender's own MikkTSpace agrees with the
+# .gltf's tangents (blender_check.py). Bad --asset requests fail
 # before any output is written.
 . "$top_srcdir/tests/lib.sh"
 need node npm blender
