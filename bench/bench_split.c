@@ -11,7 +11,7 @@
 #include "geom/delaunay.h"
 #include "geom/sample.h"
 #include "io/preset.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 /* CPU seconds of the process (all threads): the machine running a benchmark may be shared. */
 static double cpu_seconds(void)
@@ -126,12 +126,12 @@ int main(int argc, char **argv)
         return fail();
     fs_points_free(&pts);
 
-    fs_config local_cfg = cfg, global_cfg = cfg;
-    local_cfg.solver.relax = FS_RELAX_LOCAL;
-    global_cfg.solver.relax = FS_RELAX_GLOBAL;
+    fs_model_setup local = fs_config_model_setup(&cfg), global = local;
+    local.solver.relax = FS_RELAX_LOCAL;
+    global.solver.relax = FS_RELAX_GLOBAL;
     fs_wedge_model wl, wg;
-    if (fs_wedge_init(&wl, &m_local, &local_cfg) < 0 || first_fracture(&wl, cfg.time.end, cfg.time.min_step) < 0 ||
-        fs_wedge_init(&wg, &m_global, &global_cfg) < 0 || fs_wedge_equilibrium(&wg, wl.time) < 0)
+    if (fs_wedge_init(&wl, &m_local, &local) < 0 || first_fracture(&wl, cfg.time.end, cfg.time.min_step) < 0 ||
+        fs_wedge_init(&wg, &m_global, &global) < 0 || fs_wedge_equilibrium(&wg, wl.time) < 0)
         return fail();
     double lw = 0.0, lc = 0.0, gw = 0.0, gc = 0.0;
     int ln = 0, gn = 0;

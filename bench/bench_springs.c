@@ -11,7 +11,7 @@
 #include "base/vec.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
-#include "model/springs/springs.h"
+#include "model/springs/internal.h"
 
 /* Mean spacing of the masses (cm): the tile grows with N so that the physics per mass stays that of
  * presets/mud-springs.ini (3000 masses on a 10 cm tile). */
@@ -74,8 +74,8 @@ int main(int argc, char **argv)
     fs_points_free(&pts);
     double t1 = fs_seconds();
 
-    fs_springs_setup st;
-    memset(&st, 0, sizeof st);
+    fs_model_setup st = fs_model_setup_default();
+    st.kind = FS_MODEL_SPRINGS;
     st.springs = fs_springs_params_default();
     st.springs.shear_lag = 2.0;
     st.springs.slide_length = 0.03;
@@ -90,18 +90,18 @@ int main(int argc, char **argv)
     st.shrink = fs_shrink_default();
     st.shrink.top = ramp(0.09);
     st.shrink.bottom = ramp(0.05);
-    st.time_end = 1.0;
-    st.min_step = 1e-3;
+    st.time.end = 1.0;
+    st.time.min_step = 1e-3;
     st.seed = 1;
 
     fs_springs s;
     fs_surface r = {0};
     int rc = fs_springs_init(&s, &m, &st);
     if (rc == 0)
-        rc = fs_springs_advance(&s, st.time_end);
+        rc = fs_springs_advance(&s, st.time.end);
     double t2 = fs_seconds();
     if (rc == 0)
-        rc = fs_springs_render(&s, &r);
+        rc = fs_springs_surface(&s, &r);
     double t3 = fs_seconds();
     if (rc < 0) {
         fprintf(stderr, "bench_springs: %s\n", fs_error_message());

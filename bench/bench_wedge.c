@@ -13,7 +13,8 @@
 #include "geom/delaunay.h"
 #include "geom/mesh.h"
 #include "geom/sample.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
+#include "sim/settings.h"
 #include "solve/cg.h"
 #include "solve/sparse.h"
 
@@ -94,8 +95,9 @@ int main(int argc, char **argv)
     }
     fs_points_free(&pts);
 
+    fs_model_setup setup = fs_config_model_setup(&cfg);
     fs_wedge_model w;
-    if (fs_wedge_init(&w, &m, &cfg) < 0 || fs_wedge_equilibrium(&w, 1.0) < 0) {
+    if (fs_wedge_init(&w, &m, &setup) < 0 || fs_wedge_equilibrium(&w, 1.0) < 0) {
         fprintf(stderr, "bench_wedge: %s\n", fs_error_message());
         return 70;
     }
@@ -137,12 +139,12 @@ int main(int argc, char **argv)
 
     /* the same removals relaxed after each event: globally (re-factorization of the stale factor, solve,
      * all stresses) and by local relaxation (thesis §5.8), on two fresh models */
-    fs_config lcfg = cfg;
-    lcfg.solver.relax = FS_RELAX_LOCAL;
+    fs_model_setup local = setup;
+    local.solver.relax = FS_RELAX_LOCAL;
     if (getenv("RELAX_TOL"))
-        lcfg.solver.relax_tolerance = strtod(getenv("RELAX_TOL"), NULL);
+        local.solver.relax_tolerance = strtod(getenv("RELAX_TOL"), NULL);
     fs_wedge_model wg, wl;
-    if (fs_wedge_init(&wg, &m, &lcfg) < 0 || fs_wedge_equilibrium(&wg, 1.0) < 0 || fs_wedge_init(&wl, &m, &lcfg) < 0 ||
+    if (fs_wedge_init(&wg, &m, &local) < 0 || fs_wedge_equilibrium(&wg, 1.0) < 0 || fs_wedge_init(&wl, &m, &local) < 0 ||
         fs_wedge_equilibrium(&wl, 1.0) < 0) {
         fprintf(stderr, "bench_wedge: %s\n", fs_error_message());
         return 70;

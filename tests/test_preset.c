@@ -140,9 +140,9 @@ static const char *config_diff(const fs_config *a, const fs_config *b, double co
     SAME(material.toughness);
     SAME(material.thickness);
     SAME(material.thickness_final);
-    SAME_STR(material.thickness_map);
-    SAME_STR(material.young_map);
-    SAME_STR(material.threshold_map);
+    SAME_STR(material_files.thickness_map);
+    SAME_STR(material_files.young_map);
+    SAME_STR(material_files.threshold_map);
     SAME(material.jitter);
     SAME(growth.type);
     SAME(growth.r1);
@@ -221,8 +221,8 @@ static void test_defaults(void)
     CHECK(c.material.young == 10000 && c.material.poisson == 0.3);
     CHECK(c.material.threshold == 200 && c.material.toughness == 200);
     CHECK(c.material.thickness == 0.5 && c.material.thickness_final == -1);
-    CHECK(c.material.thickness_map[0] == '\0' && c.material.young_map[0] == '\0' &&
-          c.material.threshold_map[0] == '\0');
+    CHECK(c.material_files.thickness_map[0] == '\0' && c.material_files.young_map[0] == '\0' &&
+          c.material_files.threshold_map[0] == '\0');
     CHECK(c.material.jitter == 0.1);
     CHECK(c.growth.type == FS_GROWTH_NONE && c.growth.r1 == 1 && c.growth.r2 == 1);
     CHECK(c.growth.angle == 0 && c.growth.rate == 1 && c.growth.axis_ratio == 1);
@@ -257,8 +257,8 @@ static void test_full_preset(void)
     CHECK(c.mesh.lattice == FS_LATTICE_HEX && c.mesh.relax_iterations == 0);
     CHECK(c.material.thickness_final == 0.3);
     /* A preset from memory has no directory: relative paths stay as written. */
-    CHECK(!strcmp(c.material.thickness_map, "textures/ramp.png"));
-    CHECK(!strcmp(c.material.young_map, "/abs/young.png"));
+    CHECK(!strcmp(c.material_files.thickness_map, "textures/ramp.png"));
+    CHECK(!strcmp(c.material_files.young_map, "/abs/young.png"));
     CHECK(c.growth.type == FS_GROWTH_CYLINDER && c.growth.r1 == -0.5);
     CHECK(c.growth.angle == 0.1 + 0.2 && c.growth.rate == 1e-300);
     CHECK(c.shrink.top.n == 3 && c.shrink.top.t[1] == 0.5 && c.shrink.top.v[2] == 0.1);
@@ -425,7 +425,7 @@ static void test_set(void)
     CHECK(fs_preset_set(&c, "mesh.elements=2500") == 0 && c.mesh.elements == 2500);
     CHECK(fs_preset_set(&c, " render.size = 300x200 ") == 0 && c.render.width == 300 && c.render.height == 200);
     CHECK(fs_preset_set(&c, "preset.description=a=b") == 0 && !strcmp(c.preset.description, "a=b"));
-    CHECK(fs_preset_set(&c, "material.young_map=maps/y.png") == 0 && !strcmp(c.material.young_map, "maps/y.png"));
+    CHECK(fs_preset_set(&c, "material.young_map=maps/y.png") == 0 && !strcmp(c.material_files.young_map, "maps/y.png"));
     CHECK(fs_preset_set(&c, "shrink.top=0:0,1:0.5") == 0);
     CHECK_NEAR(fs_pwl_eval(&c.shrink.top, 0.5), 0.25, 1e-15);
 
@@ -532,8 +532,8 @@ static void test_file_load(void)
     CHECK_MSG(fs_preset_load(path, &c) == 0, "%s", fs_error_message());
     char want[400];
     snprintf(want, sizeof want, "%s/../textures/ramp.png", sub);
-    CHECK_MSG(!strcmp(c.material.thickness_map, want), "%s", c.material.thickness_map);
-    CHECK(!strcmp(c.material.young_map, "/abs/y.png"));
+    CHECK_MSG(!strcmp(c.material_files.thickness_map, want), "%s", c.material_files.thickness_map);
+    CHECK(!strcmp(c.material_files.young_map, "/abs/y.png"));
 
     /* Resolved paths survive a dump and reload from anywhere. */
     char *text = dump_string(&c);
@@ -542,7 +542,7 @@ static void test_file_load(void)
     write_file(path2, text);
     fs_config d = fs_config_default();
     CHECK(fs_preset_load(path2, &d) == 0);
-    CHECK(!strcmp(d.material.thickness_map, want));
+    CHECK(!strcmp(d.material_files.thickness_map, want));
     free(text);
 
     /* A missing file is FS_ERR_NOINPUT; an error inside a file names it with its line. */

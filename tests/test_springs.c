@@ -1,5 +1,5 @@
 /* Tests of the springs model: relaxation, uniform strain on periodic lattices, crack directions, fracture invariants, the 3-D post-process. */
-#include "model/springs/springs.h"
+#include "model/springs/internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -66,10 +66,10 @@ static fs_pwl constant(double v)
 }
 
 /* Break strain 0.01 (threshold 100 kPa on 10 MPa), no jitter, static background, time [0, 1]. */
-static fs_springs_setup base_setup(void)
+static fs_model_setup base_setup(void)
 {
-    fs_springs_setup st;
-    memset(&st, 0, sizeof st);
+    fs_model_setup st = fs_model_setup_default();
+    st.kind = FS_MODEL_SPRINGS;
     st.springs = fs_springs_params_default();
     st.material = fs_material_default();
     st.material.young = 10.0;
@@ -78,8 +78,8 @@ static fs_springs_setup base_setup(void)
     st.material.jitter = 0.0;
     st.growth = fs_growth_default();
     st.shrink = fs_shrink_default();
-    st.time_end = 1.0;
-    st.min_step = 1e-3;
+    st.time.end = 1.0;
+    st.time.min_step = 1e-3;
     st.seed = 7;
     return st;
 }
@@ -113,7 +113,7 @@ static void test_relaxation(void)
     fs_mesh m = {0};
     if (!make_mesh(&d, 500, false, 3, &m))
         return;
-    fs_springs_setup st = base_setup();
+    fs_model_setup st = base_setup();
     st.shrink.top = st.shrink.bottom = constant(0.004);
     st.material.threshold = 1000.0; /* nothing breaks here */
     fs_springs s;
@@ -157,7 +157,7 @@ static void test_uniform_strain_periodic(void)
     fs_mesh m = {0};
     if (!make_mesh(&d, 400, true, 1, &m))
         return;
-    fs_springs_setup st = base_setup();
+    fs_model_setup st = base_setup();
     st.material.threshold = 1000.0; /* break strain 0.1: nothing breaks */
     double shrink = 0.03;
     st.shrink.top = st.shrink.bottom = constant(shrink);
@@ -217,7 +217,7 @@ static void test_hex_three_directions(void)
     fs_mesh m = {0};
     if (!make_mesh(&d, 700, true, 1, &m))
         return;
-    fs_springs_setup st = base_setup();
+    fs_model_setup st = base_setup();
     st.material.jitter = 0.05;
     st.shrink.top = st.shrink.bottom = ramp(0.05);
     st.springs.slide_length = 0.02;
@@ -295,7 +295,7 @@ static void test_cylinder_axis(void)
     fs_mesh m = {0};
     if (!make_mesh(&d, 700, false, 5, &m))
         return;
-    fs_springs_setup st = base_setup();
+    fs_model_setup st = base_setup();
     st.material.jitter = 0.1;
     st.growth.type = FS_GROWTH_CYLINDER;
     st.growth.rate = 0.2;
@@ -337,7 +337,7 @@ static void test_fracture_invariants(void)
     fs_mesh m = {0};
     if (!make_mesh(&d, 800, false, 11, &m))
         return;
-    fs_springs_setup st = base_setup();
+    fs_model_setup st = base_setup();
     st.material.jitter = 0.1;
     st.shrink.top = st.shrink.bottom = ramp(0.03);
     st.springs.slide_length = 0.02;
@@ -378,7 +378,7 @@ static void test_fracture_invariants(void)
 /* Same seed, identical breaks, positions and render mesh; another seed, other breaks. */
 static void run_small(uint64_t seed, fs_springs *s, fs_surface *r, fs_mesh *m)
 {
-    fs_springs_setup st = base_setup();
+    fs_model_setup st = base_setup();
     st.seed = seed;
     st.material.jitter = 0.1;
     st.shrink.top = st.shrink.bottom = ramp(0.04);
@@ -387,7 +387,7 @@ static void run_small(uint64_t seed, fs_springs *s, fs_surface *r, fs_mesh *m)
     CHECK_MSG(fs_springs_init(s, m, &st) == 0, "%s", fs_error_message());
     CHECK_MSG(fs_springs_advance(s, 1.0) == 0, "%s", fs_error_message());
     memset(r, 0, sizeof *r);
-    CHECK_MSG(fs_springs_render(s, r) == 0, "%s", fs_error_message());
+    CHECK_MSG(fs_springs_surface(s, r) == 0, "%s", fs_error_message());
 }
 
 static bool same_breaks(const fs_springs *a, const fs_springs *b)
@@ -442,7 +442,7 @@ static void test_render_depth(void)
     fs_mesh m = {0};
     if (!make_mesh(&d, 400, false, 4, &m))
         return;
-    fs_springs_setup st = base_setup();
+    fs_model_setup st = base_setup();
     st.material.jitter = 0.05;
     st.material.thickness = 0.45;
     st.shrink.top = ramp(0.05);
@@ -462,7 +462,7 @@ static void test_render_depth(void)
     }
     CHECK_MSG(partial > 0 && full > 0, "%d partial-depth and %d full-depth cracks", (int)partial, (int)full);
     fs_surface r = {0};
-    CHECK_MSG(fs_springs_render(&s, &r) == 0, "%s", fs_error_message());
+    CHECK_MSG(fs_springs_surface(&s, &r) == 0, "%s", fs_error_message());
     /* level 2 of 3 at its shrinkage: 0.45 * 2/3 * (1 - (0.035 + 0.015 * 2/3)) */
     double level2 = 0.45 * 2.0 / 3.0 * (1.0 - (0.035 + 0.015 * 2.0 / 3.0));
     int32_t at_level2 = 0, at_bottom = 0;
@@ -493,7 +493,7 @@ static void test_render_depth(void)
         s.setup.springs.post = mode ? FS_SPRINGS_POST_CURL : FS_SPRINGS_POST_GLUE;
         s.setup.springs.peel = 1.0;
         memset(&r, 0, sizeof r);
-        CHECK_MSG(fs_springs_render(&s, &r) == 0, "%s", fs_error_message());
+        CHECK_MSG(fs_springs_surface(&s, &r) == 0, "%s", fs_error_message());
         double hmax = 0.0;
         for (int32_t v = 0; v < r.n_verts; v++) {
             CHECK(isfinite(r.height[v]));
@@ -518,7 +518,7 @@ static void test_bad_parameters(void)
     if (!make_mesh(&d, 100, false, 1, &m))
         return;
     fs_springs s;
-    fs_springs_setup st = base_setup();
+    fs_model_setup st = base_setup();
     st.springs.layers = 0;
     CHECK(fs_springs_init(&s, &m, &st) == -1);
     CHECK(fs_error_domain() == FS_ERR_DATA && strstr(fs_error_message(), "[springs] layers"));

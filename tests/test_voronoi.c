@@ -489,7 +489,7 @@ static void test_bad_input(void)
     memset(&empty, 0, sizeof empty);
     empty.domain = fs_domain_default();
     fs_error_clear();
-    CHECK(fs_voronoi_render_mesh(&empty, &p, 1, &r) == -1);
+    CHECK(fs_voronoi_surface(&empty, &p, 1, &r) == -1);
     CHECK(fs_error_domain() == FS_ERR_DATA);
     CHECK(strstr(fs_error_message(), "voronoi") != NULL);
 
@@ -500,7 +500,7 @@ static void test_bad_input(void)
     free(m.ring_start);
     m.ring_start = NULL;
     fs_error_clear();
-    CHECK(fs_voronoi_render_mesh(&m, &p, 1, &r) == -1);
+    CHECK(fs_voronoi_surface(&m, &p, 1, &r) == -1);
     CHECK(fs_error_domain() == FS_ERR_DATA);
     CHECK(r.n_verts == 0 && r.n_tris == 0);
     fs_mesh_free(&m);
@@ -522,7 +522,7 @@ static void check_periodic_tiling(double warp)
     p.subdivisions = 5;
     fs_surface r;
     memset(&r, 0, sizeof r);
-    CHECK(fs_voronoi_render_mesh(&m, &p, 42, &r) == 0);
+    CHECK(fs_voronoi_surface(&m, &p, 42, &r) == 0);
     areas a = measure(&r);
     CHECK_NEAR(a.abs_area, 1.0, 1e-6);
     CHECK_MSG(a.min_area > -1e-10, "warp %g: a triangle is clockwise (area %g)", warp, a.min_area);
@@ -570,7 +570,7 @@ static void test_warp_moves_cracks(void)
         p.warp = run ? 0.2 : 0.0;
         fs_surface r;
         memset(&r, 0, sizeof r);
-        CHECK(fs_voronoi_render_mesh(&m, &p, 7, &r) == 0);
+        CHECK(fs_voronoi_surface(&m, &p, 7, &r) == 0);
         for (int32_t v = 0; v < r.n_verts; v++) {
             if (r.crack[v] != 1.0f)
                 continue;
@@ -611,7 +611,7 @@ static void test_periodic_x_strip(void)
         p.warp = warped ? 0.15 : 0.0;
         fs_surface r;
         memset(&r, 0, sizeof r);
-        CHECK(fs_voronoi_render_mesh(&m, &p, 3, &r) == 0);
+        CHECK(fs_voronoi_surface(&m, &p, 3, &r) == 0);
         areas a = measure(&r);
         CHECK_NEAR(a.abs_area, 1.0, 1e-6);
         CHECK(a.min_area > -1e-10);
@@ -642,9 +642,9 @@ static void test_ids_and_determinism(void)
     memset(&r1, 0, sizeof r1);
     memset(&r2, 0, sizeof r2);
     memset(&r3, 0, sizeof r3);
-    CHECK(fs_voronoi_render_mesh(&m, &p, 5, &r1) == 0);
-    CHECK(fs_voronoi_render_mesh(&m, &p, 5, &r2) == 0);
-    CHECK(fs_voronoi_render_mesh(&m, &p, 6, &r3) == 0);
+    CHECK(fs_voronoi_surface(&m, &p, 5, &r1) == 0);
+    CHECK(fs_voronoi_surface(&m, &p, 5, &r2) == 0);
+    CHECK(fs_voronoi_surface(&m, &p, 6, &r3) == 0);
     CHECK(r1.n_verts == r2.n_verts && r1.n_tris == r2.n_tris);
     CHECK(memcmp(r1.uv, r2.uv, 2 * (size_t)r1.n_verts * sizeof *r1.uv) == 0);
     CHECK(memcmp(r1.tri, r2.tri, 3 * (size_t)r1.n_tris * sizeof *r1.tri) == 0);
@@ -703,7 +703,7 @@ static void test_sphere(void)
         p.warp_scale = 1.5;
         fs_surface r;
         memset(&r, 0, sizeof r);
-        CHECK(fs_voronoi_render_mesh(&m, &p, 8, &r) == 0);
+        CHECK(fs_voronoi_surface(&m, &p, 8, &r) == 0);
         areas a = measure(&r);
         CHECK_MSG(fabs(a.abs_area - 1.0) < 1e-4, "warp %g: uv area %.6f", p.warp, a.abs_area);
         /* slivers next to the poles may flip in the degenerate map; together they cover less than
@@ -757,7 +757,7 @@ static void check_delaunay(fs_domain d, int32_t count, double warp)
     p.warp = warp;
     fs_surface r;
     memset(&r, 0, sizeof r);
-    CHECK(fs_voronoi_render_mesh(&m, &p, 4, &r) == 0);
+    CHECK(fs_voronoi_surface(&m, &p, 4, &r) == 0);
     const char *name = fs_domain_type_name(d.type);
     bool wu = fs_domain_wraps_u(&d), wv = fs_domain_wraps_v(&d);
     bool sphere = d.type == FS_DOMAIN_SPHERE;

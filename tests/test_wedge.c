@@ -7,6 +7,7 @@
 #include "base/error.h"
 #include "base/vec.h"
 #include "check.h"
+#include "setup.h"
 #include "wedge_fixture.h"
 #include "fracture/eigen.h"
 #include "fracture/event.h"
@@ -14,7 +15,7 @@
 #include "geom/refine.h"
 #include "geom/sample.h"
 #include "image/image.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 #include "model/wedge/element.h"
 
 /* A configuration for the wedge model: E = 10000 MPa, nu = 0.3, no jitter, no growth, no shrinkage. */
@@ -79,7 +80,7 @@ static void test_bonded_layer_shrinkage(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 1200, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     CHECK(fs_wedge_equilibrium(&w, 1.0) == 0);
     double expect = cfg.material.young * eps / (1.0 - cfg.material.poisson);
     double worst = 0.0, worst_other = 0.0;
@@ -146,7 +147,7 @@ static void test_anisotropic_growth(void)
         fs_mesh m = {0};
         CHECK(wedge_test_mesh(&cfg, 1200, &m) == 0);
         fs_wedge_model w;
-        CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+        CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
         CHECK(w.growth_mode == (periodic ? FS_WEDGE_GROWTH_EIGENSTRAIN : FS_WEDGE_GROWTH_MOVE));
         CHECK(fs_wedge_equilibrium(&w, t) == 0);
         double worst_angle = 0.0, worst_sigma = 0.0, sum = 0.0;
@@ -189,7 +190,7 @@ static void test_patch(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 160, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     const double A[2][2] = {{1e-3, 2e-4}, {-5e-4, 3e-4}}, a = 4e-4, b = -2e-4, nu = cfg.material.poisson;
     const double wz[3] = {-a, -b, -nu / (1.0 - nu) * (A[0][0] + A[1][1])};
     const double strain[6] = {A[0][0], A[1][1], wz[2], A[0][1] + A[1][0], 0.0, 0.0};
@@ -258,7 +259,7 @@ static void test_event_time(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 100, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     fs_event_result r;
     CHECK(fs_event_find(event_fn, &w, 0.0, 0.01, 1.0, cfg.time.min_step, &r) == 0);
     CHECK(r.found);
@@ -296,9 +297,9 @@ static void test_cholmod_vs_cg(void)
     CHECK(wedge_test_mesh(&cfg, 600, &m2) == 0);
     fs_wedge_model a, b;
     cfg.solver.method = FS_SOLVER_CHOLMOD;
-    CHECK(fs_wedge_init(&a, &m1, &cfg) == 0);
+    CHECK(fs_wedge_init(&a, &m1, SETUP(&cfg)) == 0);
     cfg.solver.method = FS_SOLVER_CG;
-    CHECK(fs_wedge_init(&b, &m2, &cfg) == 0);
+    CHECK(fs_wedge_init(&b, &m2, SETUP(&cfg)) == 0);
     for (int round = 0; round < 2; round++) {
         CHECK(fs_wedge_equilibrium(&a, 0.5) == 0);
         CHECK(fs_wedge_equilibrium(&b, 0.5) == 0);
@@ -330,7 +331,7 @@ static void test_updates_match_fresh_assembly(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 400, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     /* all the elements around node 10 (orphaning its top node), and a scattered few */
     for (int32_t p = w.node_elem_start[10]; p < w.node_elem_start[10] + w.node_elem_count[10]; p++)
         CHECK(fs_wedge_remove(&w, w.node_elem[p]) == 0);
@@ -375,7 +376,7 @@ static void test_cylinder_growth(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 600, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     double t = 2e-3, eps = cfg.growth.rate * t / cfg.domain.radius, nu = cfg.material.poisson;
     double expect = cfg.material.young * eps / (1.0 - nu * nu);
     CHECK(fs_wedge_equilibrium(&w, t) == 0);
@@ -409,7 +410,7 @@ static void test_sphere_growth(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 1500, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     CHECK(w.growth_mode == FS_WEDGE_GROWTH_MOVE && !w.flat);
     double t = 3e-4, eps = cfg.growth.rate * t / cfg.domain.radius, nu = cfg.material.poisson;
     double z = 0.5 * (1.0 + fs_wedge_gauss[0][2]) * cfg.material.thickness;
@@ -443,7 +444,7 @@ static void test_removal_run(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 400, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     CHECK(fs_wedge_simulate(&w, 1.0) == 0);
     CHECK(w.time == 1.0);
     CHECK(w.fractures > 10);
@@ -456,7 +457,7 @@ static void test_removal_run(void)
     int32_t fragments = fs_wedge_fragments(&w, label);
     CHECK_MSG(fragments >= 2, "%d fragments", (int)fragments);
     fs_surface r;
-    CHECK(fs_wedge_render_mesh(&w, &r) == 0);
+    CHECK(fs_wedge_surface(&w, &r) == 0);
     CHECK(r.n_tris == w.n_elems);
     int cracks = 0, bad = 0;
     for (int32_t t = 0; t < r.n_tris; t++) {
@@ -492,7 +493,7 @@ static void test_subdivision_run(void)
     CHECK(wedge_test_mesh(&cfg, 60, &m) == 0);
     int32_t tris0 = m.n_tris;
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     CHECK(fs_wedge_simulate(&w, 1.0) == 0);
     CHECK(w.counters.subdivisions > 0 && w.n_elems > tris0);
     CHECK(w.fractures > 5);
@@ -548,8 +549,8 @@ static void test_lazy_ratios(void)
     CHECK(wedge_test_mesh(&cfg, 400, &m1) == 0);
     CHECK(wedge_test_mesh(&cfg, 400, &m2) == 0);
     fs_wedge_model a, b;
-    CHECK(fs_wedge_init(&a, &m1, &cfg) == 0);
-    CHECK(fs_wedge_init(&b, &m2, &cfg) == 0);
+    CHECK(fs_wedge_init(&a, &m1, SETUP(&cfg)) == 0);
+    CHECK(fs_wedge_init(&b, &m2, SETUP(&cfg)) == 0);
     b.lazy_ratios = true;
     /* stresses grow in proportion to t: go to just past the first fracture */
     CHECK(fs_wedge_equilibrium(&a, 1.0) == 0);
@@ -599,13 +600,13 @@ static void test_thickness_over_time(void)
     CHECK(wedge_test_mesh(&cfg, 150, &m1) == 0);
     CHECK(wedge_test_mesh(&cfg, 150, &m2) == 0);
     fs_wedge_model a, b;
-    CHECK(fs_wedge_init(&a, &m1, &cfg) == 0);
+    CHECK(fs_wedge_init(&a, &m1, SETUP(&cfg)) == 0);
     CHECK(fs_wedge_remove(&a, 7) == 0);
     CHECK(fs_wedge_equilibrium(&a, 0.5) == 0);
     CHECK_NEAR(a.assembled_thickness, 0.4, 1e-15);
     cfg.material.thickness = 0.4;
     cfg.material.thickness_final = -1.0;
-    CHECK(fs_wedge_init(&b, &m2, &cfg) == 0);
+    CHECK(fs_wedge_init(&b, &m2, SETUP(&cfg)) == 0);
     CHECK(fs_wedge_remove(&b, 7) == 0);
     CHECK(fs_wedge_equilibrium(&b, 0.5) == 0);
     double d = rel_diff(a.u, b.u, 6 * (size_t)a.n_nodes);
@@ -621,26 +622,23 @@ static void test_thickness_over_time(void)
  * mesh's heights are the thickness times 1 + gradient (u - 1/2) times the map's grey level. */
 static void test_thickness_gradient_and_map(void)
 {
-    const char *path = "test_wedge_thickness.png";
-    fs_image img;
-    fs_image_alloc(&img, 16, 16, 1, FS_PIX_U8);
+    float grey[16 * 16];
     for (int j = 0; j < 16; j++) /* grey = v at the pixel centres: rows top to bottom */
         for (int i = 0; i < 16; i++)
-            ((uint8_t *)img.data)[16 * j + i] = (uint8_t)lround(255.0 * (1.0 - (j + 0.5) / 16.0));
-    CHECK(fs_image_write(path, &img) == 0);
-    fs_image_free(&img);
+            grey[16 * j + i] = (float)(1.0 - (j + 0.5) / 16.0);
     fs_config cfg = base_config();
     cfg.domain.width = cfg.domain.height = 2.0;
     cfg.material.thickness = 0.5;
     cfg.wedge.thickness_gradient = 0.8;
-    snprintf(cfg.material.thickness_map, sizeof cfg.material.thickness_map, "%s", path);
+    fs_model_setup setup = fs_config_model_setup(&cfg);
+    setup.thickness_map = (fs_grey_map){.width = 16, .height = 16, .grey = grey};
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 200, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, &setup) == 0);
     CHECK(fs_wedge_equilibrium(&w, 0.0) == 0);
     fs_surface r;
-    CHECK(fs_wedge_render_mesh(&w, &r) == 0);
+    CHECK(fs_wedge_surface(&w, &r) == 0);
     double worst = 0.0;
     for (int32_t v = 0; v < r.n_verts; v++) {
         double u = r.uv[2 * v], vv = r.uv[2 * v + 1];
@@ -654,7 +652,6 @@ static void test_thickness_gradient_and_map(void)
     fs_surface_free(&r);
     fs_wedge_free(&w);
     fs_mesh_free(&m);
-    remove(path);
 }
 
 int main(void)

@@ -7,10 +7,11 @@
 
 #include "base/error.h"
 #include "check.h"
+#include "setup.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
 #include "io/preset.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 #define DEG (180.0 / 3.14159265358979323846)
 
@@ -130,7 +131,7 @@ static void simulate(const fs_config *cfg, const char *what, run *r)
         return;
     r->h0 = mean_edge(&r->mesh);
     fs_wedge_model w;
-    rc = fs_wedge_init(&w, &r->mesh, cfg);
+    rc = fs_wedge_init(&w, &r->mesh, SETUP(cfg));
     CHECK_MSG(rc == 0, "%s: init: %s", what, fs_error_message());
     if (rc < 0)
         return;

@@ -6,10 +6,11 @@
 
 #include "base/error.h"
 #include "check.h"
+#include "setup.h"
 #include "wedge_fixture.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 /* A bonded layer 0.2 cm thick, E = 10000 MPa, nu = 0.3, whose top shrinks twice as fast as its bottom. */
 static fs_config base_config(double size, fs_relax_mode relax)
@@ -88,8 +89,8 @@ static void pair_init_with(fs_mesh *m, fs_config ca, fs_wedge_model *a, fs_wedge
 {
     fs_config cb = ca;
     cb.solver.relax = FS_RELAX_GLOBAL;
-    CHECK(fs_wedge_init(a, m, &ca) == 0);
-    CHECK(fs_wedge_init(b, m, &cb) == 0);
+    CHECK(fs_wedge_init(a, m, SETUP(&ca)) == 0);
+    CHECK(fs_wedge_init(b, m, SETUP(&cb)) == 0);
     CHECK(fs_wedge_equilibrium(a, 1.0) == 0);
     CHECK(fs_wedge_equilibrium(b, 1.0) == 0);
 }
@@ -148,6 +149,29 @@ static void test_local_matches_global(void)
     fs_mesh_free(&m);
 }
 
+/* A global solve with a stale factor that CG cannot finish (here: an iteration limit far too small)
+ * falls back to a fresh factorization and the direct solve, and gets the factor's answer. */
+static void test_stalled_cg_falls_back(void)
+{
+    fs_config cfg = base_config(4.0, FS_RELAX_LOCAL);
+    cfg.solver.max_iterations = 3;
+    fs_mesh m = {0};
+    CHECK(wedge_test_mesh(&cfg, 600, &m) == 0);
+    fs_wedge_model a, b;
+    pair_init_with(&m, cfg, &a, &b);
+    CHECK(fs_wedge_remove(&a, element_near(&m, 2.0, 2.0)) == 0);
+    CHECK(fs_wedge_remove(&b, element_near(&m, 2.0, 2.0)) == 0);
+    CHECK(a.factor_stale);
+    int64_t factorizations = a.counters.factorizations;
+    CHECK_MSG(fs_wedge_equilibrium(&a, 0.9) == 0, "%s", fs_error_message());
+    CHECK(fs_wedge_equilibrium(&b, 0.9) == 0);
+    CHECK(!a.factor_stale && a.counters.factorizations == factorizations + 1);
+    CHECK_MSG(u_diff(&a, &b) < 1e-9, "fallback and factor differ by %.3g of the largest", u_diff(&a, &b));
+    fs_wedge_free(&a);
+    fs_wedge_free(&b);
+    fs_mesh_free(&m);
+}
+
 /* Is the node in the list? */
 static bool listed(const int32_t *list, int32_t n, int32_t node)
 {
@@ -166,7 +190,7 @@ static void test_crack_is_barrier(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 800, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     CHECK(fs_wedge_equilibrium(&w, 1.0) == 0);
     const double x0 = 1.8, x1 = 2.2, radius = 1.5;
     int32_t seed = -1;
@@ -315,5 +339,6 @@ int main(void)
     RUN(test_crack_is_barrier);
     RUN(test_radius_control);
     RUN(test_far_change_is_local);
+    RUN(test_stalled_cg_falls_back);
     return check_finish();
 }

@@ -6,10 +6,11 @@
 
 #include "base/error.h"
 #include "check.h"
+#include "setup.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
 #include "io/preset.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 /* A preset of presets/ with the given element count and seed, fracture by splitting. */
 static fs_config preset_config(const char *name, int32_t elements, uint64_t seed)
@@ -45,13 +46,13 @@ static int run(const fs_config *cfg, fs_surface *out, fs_domain *domain)
     }
     fs_points_free(&pts);
     fs_wedge_model w;
-    if (fs_wedge_init(&w, &m, cfg) < 0) {
+    if (fs_wedge_init(&w, &m, SETUP(cfg)) < 0) {
         fs_mesh_free(&m);
         return -1;
     }
     int rc = fs_wedge_simulate(&w, cfg->time.end);
     if (rc == 0)
-        rc = fs_wedge_render_mesh(&w, out);
+        rc = fs_wedge_surface(&w, out);
     printf("  %s seed %llu: %lld splits, %d render triangles\n", cfg->preset.name, (unsigned long long)cfg->preset.seed,
            (long long)w.fractures, (int)out->n_tris);
     fs_wedge_free(&w);

@@ -7,11 +7,12 @@
 #include "base/error.h"
 #include "base/vec.h"
 #include "check.h"
+#include "setup.h"
 #include "wedge_fixture.h"
 #include "geom/delaunay.h"
 #include "geom/refine.h"
 #include "geom/sample.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 /* Crack edges of a periodic mesh: boundary half-edges (each crack edge appears once per side). Sums
  * their length and the length-weighted doubled-angle moments of their directions. */
@@ -151,7 +152,7 @@ static void test_crack_perpendicular(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     int32_t nodes0 = w.n_nodes;
     /* run until the first cracks have run */
     CHECK(fs_wedge_simulate(&w, 0.3) == 0);
@@ -179,7 +180,7 @@ static void test_single_split(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 400, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     double t = 0.0;
     /* bring the layer over its threshold */
     while (t < 1.0) {
@@ -315,7 +316,7 @@ static void open_strip(fs_mesh *m, fs_wedge_model *w)
     fs_config cfg = wedge_strip_config();
     cfg.domain.periodic_x = cfg.domain.periodic_y = false;
     CHECK(wedge_test_mesh(&cfg, 600, m) == 0);
-    CHECK(fs_wedge_init(w, m, &cfg) == 0);
+    CHECK(fs_wedge_init(w, m, SETUP(&cfg)) == 0);
 }
 
 static void test_extended_matrix_is_fresh(void)
@@ -392,7 +393,7 @@ static void test_griffith(void)
         fs_mesh m = {0};
         CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
         fs_wedge_model w;
-        CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+        CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
         CHECK(fs_wedge_simulate(&w, 0.3) == 0);
         length[k] = longest_crack(&m);
         stops[k] = w.griffith_stops;

@@ -8,11 +8,12 @@
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "check.h"
+#include "setup.h"
 #include "wedge_fixture.h"
 #include "geom/delaunay.h"
 #include "geom/refine.h"
 #include "geom/sample.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 /* The strip of wedge_fixture.h, relaxed to a tight tolerance. */
 static fs_config strip_config(void)
@@ -226,7 +227,7 @@ static void test_vm_refinement(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     grow_crack(&w, 3);
     CHECK(fs_wedge_equilibrium(&w, w.time) == 0);
     CHECK(w.n_tips == 2);
@@ -305,7 +306,7 @@ static void test_submodel(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     grow_crack(&w, 3);
     CHECK(fs_wedge_equilibrium(&w, w.time) == 0);
     CHECK(w.n_tips == 2);
@@ -438,7 +439,7 @@ static void test_smooth_distorted(void)
     for (int k = 0; k < 2; k++)
         m.pos[3 * node + k] += 0.6 * (b[k] - a[k]);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     CHECK(fs_wedge_equilibrium(&w, 0.15) == 0);
     double unit = fs_wedge_tips_unit(&w);
     int32_t *region = malloc(sizeof *region * (size_t)w.n_nodes);
@@ -468,7 +469,7 @@ static void test_smooth_tip(void)
     fs_mesh m = {0};
     CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
     fs_wedge_model w;
-    CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
     grow_crack(&w, 3);
     CHECK(w.n_tips == 2);
     double unit = fs_wedge_tips_unit(&w);
@@ -542,7 +543,7 @@ static void test_simulation(void)
         fs_mesh m = {0};
         CHECK(wedge_test_mesh(&cfg, 450, &m) == 0);
         fs_wedge_model w;
-        CHECK(fs_wedge_init(&w, &m, &cfg) == 0);
+        CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
         CHECK(fs_wedge_simulate(&w, 0.3) == 0);
         double coherence, length, angle = crack_angle(&m, &coherence, &length);
         const fs_wedge_counters *c = &w.counters;

@@ -4,7 +4,7 @@
 
 #include "geom/delaunay.h"
 #include "geom/sample.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 /* A mesh of about `points` nodes sampled by repulsion on cfg's domain with cfg's seed. Returns 0 or
  * -1 with fs_error. */

@@ -4,7 +4,6 @@
 
 #include <stdbool.h>
 
-#define FS_PATH_MAX 1024
 #define FS_PWL_MAX 32
 
 /* Piecewise-linear function of time given as "t:value" pairs with increasing t; constant outside. */
@@ -23,9 +22,6 @@ typedef struct {
     double toughness;       /* fracture toughness (J/m^2) */
     double thickness;       /* layer thickness at t = 0 (cm) */
     double thickness_final; /* thickness at time.end (cm); linear in between; < 0 means constant */
-    char thickness_map[FS_PATH_MAX]; /* grey-level image scaling the thickness, "" for none */
-    char young_map[FS_PATH_MAX];     /* grey-level image scaling Young's modulus */
-    char threshold_map[FS_PATH_MAX]; /* grey-level image scaling the threshold stress */
     double jitter;          /* relative random per-element perturbation of the threshold, [0, 1) */
 } fs_material;
 

@@ -17,7 +17,7 @@
 #include "base/error.h"
 
 /* The table below stores enums and counts through int pointers. */
-_Static_assert(sizeof(fs_model_type) == sizeof(int), "enum fs_model_type is int-sized");
+_Static_assert(sizeof(fs_model_kind) == sizeof(int), "enum fs_model_kind is int-sized");
 _Static_assert(sizeof(fs_domain_type) == sizeof(int), "enum fs_domain_type is int-sized");
 _Static_assert(sizeof(fs_lattice) == sizeof(int), "enum fs_lattice is int-sized");
 _Static_assert(sizeof(fs_growth_type) == sizeof(int), "enum fs_growth_type is int-sized");
@@ -102,9 +102,9 @@ static const key_def key_table[] = {
     {"material", "toughness", KEY_REAL, OFF(material.toughness), 0, 0, GE, NULL, "J/m^2"},
     {"material", "thickness", KEY_REAL, OFF(material.thickness), 0, 0, GT, NULL, "cm"},
     {"material", "thickness_final", KEY_REAL_NONE, OFF(material.thickness_final), 0, 0, GT, NULL, "cm"},
-    {"material", "thickness_map", KEY_PATH, OFF(material.thickness_map), 0, 0, 0, NULL, NULL},
-    {"material", "young_map", KEY_PATH, OFF(material.young_map), 0, 0, 0, NULL, NULL},
-    {"material", "threshold_map", KEY_PATH, OFF(material.threshold_map), 0, 0, 0, NULL, NULL},
+    {"material", "thickness_map", KEY_PATH, OFF(material_files.thickness_map), 0, 0, 0, NULL, NULL},
+    {"material", "young_map", KEY_PATH, OFF(material_files.young_map), 0, 0, 0, NULL, NULL},
+    {"material", "threshold_map", KEY_PATH, OFF(material_files.threshold_map), 0, 0, 0, NULL, NULL},
     {"material", "jitter", KEY_REAL, OFF(material.jitter), 0, 0.99, GE | LE, NULL, NULL},
 
     {"growth", "type", KEY_WORD, OFF(growth.type), 0, 0, 0, growth_words, NULL},

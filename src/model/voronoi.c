@@ -691,7 +691,7 @@ static int check_params(const fs_voronoi_params *p)
     return 0;
 }
 
-int fs_voronoi_render_mesh(const fs_mesh *m, const fs_voronoi_params *p, uint64_t seed, fs_surface *out)
+int fs_voronoi_surface(const fs_mesh *m, const fs_voronoi_params *p, uint64_t seed, fs_surface *out)
 {
     if (m->n_nodes <= 0 || m->n_tris <= 0) {
         fs_error(FS_ERR_DATA, "voronoi: the mesh has no nodes or triangles");

@@ -21,6 +21,6 @@ fs_voronoi_params fs_voronoi_params_default(void);
 /* Builds the texture-space render mesh of the cracked cells for Delaunay mesh m (its dual gives
  * the cells). Cell ids are node index + 1 (wrapping past 65535 to stay non-zero). Periodic domains
  * stay periodic: warping noise wraps with the domain. Returns 0 or -1 with fs_error. */
-int fs_voronoi_render_mesh(const fs_mesh *m, const fs_voronoi_params *p, uint64_t seed, fs_surface *out);
+int fs_voronoi_surface(const fs_mesh *m, const fs_voronoi_params *p, uint64_t seed, fs_surface *out);
 
 #endif

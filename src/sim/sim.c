@@ -8,9 +8,8 @@
 #include "base/log.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
-#include "model/springs/springs.h"
-#include "model/voronoi.h"
-#include "model/wedge/wedge.h"
+#include "image/image.h"
+#include "model/model.h"
 
 /* Points for the mesh: particle repulsion, or the hexagonal lattice. */
 static int sample_points(const fs_config *cfg, fs_points *pts)
@@ -33,65 +32,62 @@ static double frame_time(const fs_config *cfg, int32_t k, int32_t count)
     return k == count ? cfg->time.end : cfg->time.end * (double)k / (double)count;
 }
 
-/* The springs model in segments: init, advance to each frame time, render each frame. */
-static int run_springs_frames(const fs_config *cfg, const fs_sim_frames *frames, fs_result *out)
+/* One grey-level map of [material] (thesis §5.9), wrapping where the domain does; none for "". */
+static int load_map(const char *path, const fs_domain *d, fs_grey_map *m)
 {
-    fs_springs_setup setup;
-    memset(&setup, 0, sizeof setup);
-    setup.springs = cfg->springs;
-    setup.material = cfg->material;
-    setup.growth = cfg->growth;
-    setup.shrink = cfg->shrink;
-    setup.time_end = cfg->time.end;
-    setup.min_step = cfg->time.min_step;
-    setup.seed = cfg->preset.seed;
-    fs_springs s;
-    int rc = fs_springs_init(&s, &out->mesh, &setup);
-    for (int32_t k = 1; rc == 0 && k <= frames->count; k++) {
-        double t = frame_time(cfg, k, frames->count);
-        fs_progress_scale(cfg->time.end > 0.0 ? t / cfg->time.end : 1.0);
-        rc = fs_springs_advance(&s, t);
-        if (rc < 0)
-            break;
-        fs_progress("springs", -1, "frame %d of %d: 3-D post-process of %d cells", (int)k, (int)frames->count,
-                    (int)out->mesh.n_nodes);
-        fs_surface frame = {0};
-        fs_surface *surface = k == frames->count ? &out->surface : &frame;
-        rc = fs_springs_render(&s, surface);
-        out->stats.fractures = s.break_count;
-        out->stats.simulated_time = s.time;
-        if (rc == 0)
-            rc = frames->fn(frames->ctx, k, frames->count, t, surface, &out->stats);
-        fs_surface_free(&frame);
-    }
-    fs_springs_free(&s);
-    return rc;
+    memset(m, 0, sizeof *m);
+    if (!path[0])
+        return 0;
+    if (fs_image_read_grey(path, &m->width, &m->height, &m->grey) < 0)
+        return -1;
+    m->wrap_u = fs_domain_wraps_u(d);
+    m->wrap_v = fs_domain_wraps_v(d);
+    return 0;
 }
 
-/* The wedge model in segments: init, simulate to each frame time, render each frame. */
-static int run_wedge_frames(const fs_config *cfg, const fs_sim_frames *frames, fs_result *out)
+static void free_maps(fs_model_setup *setup)
 {
-    fs_wedge_model w;
-    if (fs_wedge_init(&w, &out->mesh, cfg) < 0)
+    fs_grey_map_free(&setup->thickness_map);
+    fs_grey_map_free(&setup->young_map);
+    fs_grey_map_free(&setup->threshold_map);
+}
+
+/* design: the one time loop of every model (model/model.h). A run without frames is the loop with one
+ * frame at time.end that hands its surface to out->surface alone. */
+static int run_model(const fs_config *cfg, const fs_domain *domain, const fs_sim_frames *frames, fs_result *out)
+{
+    fs_model_setup setup = fs_config_model_setup(cfg);
+    const fs_material_files *files = &cfg->material_files;
+    if (load_map(files->thickness_map, domain, &setup.thickness_map) < 0 ||
+        load_map(files->young_map, domain, &setup.young_map) < 0 ||
+        load_map(files->threshold_map, domain, &setup.threshold_map) < 0) {
+        free_maps(&setup);
         return -1;
-    int rc = 0;
-    for (int32_t k = 1; rc == 0 && k <= frames->count; k++) {
-        double t = frame_time(cfg, k, frames->count);
+    }
+    fs_progress("model", -1, "%s model on %d nodes", fs_model_name(setup.kind), (int)out->mesh.n_nodes);
+    fs_model model;
+    int rc = fs_model_init(&model, &out->mesh, &setup);
+    int32_t count = frames ? frames->count : 1;
+    for (int32_t k = 1; rc == 0 && k <= count; k++) {
+        double t = frame_time(cfg, k, count);
         fs_progress_scale(cfg->time.end > 0.0 ? t / cfg->time.end : 1.0);
-        rc = fs_wedge_simulate(&w, t);
-        if (rc < 0)
+        if ((rc = fs_model_advance(&model, t)) < 0)
             break;
+        fs_progress("surface", -1, "%s model at t = %.4g", fs_model_name(setup.kind), t);
         fs_surface frame = {0};
-        fs_surface *surface = k == frames->count ? &out->surface : &frame;
-        rc = fs_wedge_render_mesh(&w, surface);
-        out->stats.fractures = w.fractures;
-        out->stats.simulated_time = w.time;
-        out->stats.elements = w.n_elems;
-        if (rc == 0)
-            rc = frames->fn(frames->ctx, k, frames->count, t, surface, &out->stats);
+        fs_surface *surface = k == count ? &out->surface : &frame;
+        rc = fs_model_surface(&model, surface);
+        fs_model_info info = fs_model_stats(&model);
+        out->stats.fractures = info.fractures;
+        out->stats.simulated_time = info.time;
+        if (rc == 0 && frames)
+            rc = frames->fn(frames->ctx, k, count, t, surface, &out->stats);
         fs_surface_free(&frame);
     }
-    fs_wedge_free(&w);
+    if (rc == 0)
+        fs_model_report(&model);
+    fs_model_free(&model);
+    free_maps(&setup);
     return rc;
 }
 
@@ -132,29 +128,7 @@ int fs_sim_run_frames(const fs_config *cfg, const fs_sim_frames *frames, fs_resu
     double t2 = fs_seconds();
     fs_debug("meshed %d nodes, %d triangles in %.2f s", (int)out->mesh.n_nodes, (int)out->mesh.n_tris, t2 - t1);
 
-    switch (cfg->preset.model) {
-    case FS_MODEL_VORONOI:
-        fs_progress("model", -1, "voronoi cells");
-        rc = fs_voronoi_render_mesh(&out->mesh, &cfg->voronoi, cfg->preset.seed, &out->surface);
-        break;
-    case FS_MODEL_SPRINGS:
-        if (segmented) {
-            rc = run_springs_frames(cfg, frames, out);
-            break;
-        }
-        rc = fs_springs_run(&out->mesh, &cfg->springs, &cfg->material, &cfg->growth, &cfg->shrink, cfg->time.end,
-                            cfg->time.min_step, cfg->preset.seed, &out->surface, &out->stats.fractures,
-                            &out->stats.simulated_time);
-        break;
-    case FS_MODEL_WEDGE:
-        rc = segmented ? run_wedge_frames(cfg, frames, out) : fs_wedge_run(cfg, &out->mesh, &out->surface, &out->stats);
-        break;
-    default:
-        fs_error(FS_ERR_DATA, "[preset] model: the %s model is not available in this build; expected voronoi",
-                 fs_model_name(cfg->preset.model));
-        rc = -1;
-        break;
-    }
+    rc = run_model(cfg, &domain, segmented ? frames : NULL, out);
     double t3 = fs_seconds();
     fs_progress_scale(1.0);
     fs_progress_done();

@@ -5,7 +5,7 @@
 #include <stdint.h>
 
 #include "geom/mesh.h"
-#include "render/render.h"
+#include "geom/surface.h"
 #include "sim/settings.h"
 
 typedef struct {
@@ -39,8 +39,8 @@ int fs_sim_run(const fs_config *cfg, fs_result *out);
 
 /* As fs_sim_run, and hands frames->fn the state at each frame time (the last one is the final state,
  * out->surface). frames may be NULL (no frames).
- * design: the physical models run in segments, [t_(k-1), t_k], each model's time loop called again
- * from where it stopped (fs_springs_advance, fs_wedge_simulate); an event search that would have
+ * design: the physical models run in segments, [t_(k-1), t_k], each advanced again from where it
+ * stopped (fs_model_advance); an event search that would have
  * stepped over t_k stops there instead, so the pattern can differ slightly from a run without
  * frames (it is still deterministic for a given seed and frame count). The voronoi model has no
  * time: frames of it are an error (FS_ERR_DATA; the CLI reports it as a usage error first). */

@@ -1,5 +1,5 @@
 /* Networks of point masses and springs relaxed to equilibrium: global inexact Newton on CHOLMOD, local conjugate gradients. */
-#include "model/springs/springs.h"
+#include "model/springs/internal.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,5 +1,5 @@
 /* The springs model's 3-D post-process (thesis §4.5, Fig. 4.10): extruded cells relaxed as spring sub-networks, drawn into a render mesh. */
-#include "model/springs/springs.h"
+#include "model/springs/internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -1063,7 +1063,7 @@ static void emit(const post_ctx *c, const fs_spring_net *net, fs_surface *out)
     free(label);
 }
 
-int fs_springs_render(const fs_springs *s, fs_surface *out)
+int fs_springs_surface(const fs_springs *s, fs_surface *out)
 {
     post_ctx c;
     memset(&c, 0, sizeof c);
@@ -1076,7 +1076,7 @@ int fs_springs_render(const fs_springs *s, fs_surface *out)
     c.period[1] = s->ext[1];
     c.t = s->time;
     fs_growth_jacobian(&s->growth, 0.0, c.t, c.J);
-    c.H = fs_material_thickness(&s->setup.material, c.t, s->setup.time_end);
+    c.H = fs_material_thickness(&s->setup.material, c.t, s->setup.time.end);
     double top = fs_pwl_eval(&s->setup.shrink.top, c.t), bottom = fs_pwl_eval(&s->setup.shrink.bottom, c.t);
     for (int k = 0; k < c.levels; k++)
         c.shrink_level[k] = bottom + (top - bottom) * k / c.L;

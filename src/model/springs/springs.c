@@ -1,5 +1,5 @@
 /* The springs model: the mass-spring network of thesis ch. 4 on a mesh, growth and shrinkage, and fracture in time. */
-#include "model/springs/springs.h"
+#include "model/springs/internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -11,7 +11,6 @@
 #include "base/vec.h"
 #include "fracture/event.h"
 #include "fracture/rank.h"
-#include "image/image.h"
 
 /* ==== the springs model ==== */
 
@@ -29,48 +28,12 @@ fs_springs_params fs_springs_params_default(void)
     return p;
 }
 
-/* A grey-level map over texture space, sampled bilinearly (wrapping where the domain wraps). */
-typedef struct {
-    int w, h;
-    float *grey;
-} grey_map;
-
-static int map_load(const char *path, grey_map *m)
+/* A grey level of a map at uv (v up), floored at 0.01 so no spring is weightless; 1 without a map. */
+static double map_sample(const fs_grey_map *m, const double *uv)
 {
-    m->w = m->h = 0;
-    m->grey = NULL;
-    if (!path[0])
-        return 0;
-    return fs_image_read_grey(path, &m->w, &m->h, &m->grey);
-}
-
-/* Grey level at uv (v up), floored at 0.01 so no spring is weightless; 1 without a map. */
-static double map_sample(const grey_map *m, const double *uv, bool wrap_u, bool wrap_v)
-{
-    if (!m->grey)
-        return 1.0;
-    double px = uv[0] * m->w - 0.5, py = (1.0 - uv[1]) * m->h - 0.5;
-    double fx = floor(px), fy = floor(py);
-    double tx = px - fx, ty = py - fy;
-    double v = 0.0;
-    for (int j = 0; j < 2; j++)
-        for (int i = 0; i < 2; i++) {
-            long x = (long)fx + i, y = (long)fy + j;
-            if (wrap_u)
-                x = ((x % m->w) + m->w) % m->w;
-            else
-                x = x < 0 ? 0 : (x >= m->w ? m->w - 1 : x);
-            if (wrap_v)
-                y = ((y % m->h) + m->h) % m->h;
-            else
-                y = y < 0 ? 0 : (y >= m->h ? m->h - 1 : y);
-            double wgt = (i ? tx : 1.0 - tx) * (j ? ty : 1.0 - ty);
-            v += wgt * m->grey[(size_t)y * (size_t)m->w + (size_t)x];
-        }
+    double v = fs_grey_map_sample(m, uv[0], uv[1]);
     return v < 0.01 ? 0.01 : v;
 }
-
-static void map_free(grey_map *m) { free(m->grey); }
 
 /* Texture coordinates of a domain point given unwrapped (wrapped here first). */
 static void point_uv(const fs_domain *d, const double *p, double *uv)
@@ -86,7 +49,7 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : (x > y ? 1 : 0);
 }
 
-static int check_setup(const fs_springs_setup *st)
+static int check_setup(const fs_model_setup *st)
 {
     const fs_springs_params *p = &st->springs;
     if (p->layers < 1 || p->layers > 8) {
@@ -115,8 +78,8 @@ static int check_setup(const fs_springs_setup *st)
         fs_error(FS_ERR_DATA, "[material] young, threshold and thickness must be > 0, jitter in [0, 1), poisson in (-1, 0.5)");
         return -1;
     }
-    if (!(st->min_step > 0.0) || !(st->time_end >= 0.0) || !isfinite(st->time_end)) {
-        fs_error(FS_ERR_DATA, "[time] end >= 0 and min_step > 0 expected (got %g, %g)", st->time_end, st->min_step);
+    if (!(st->time.min_step > 0.0) || !(st->time.end >= 0.0) || !isfinite(st->time.end)) {
+        fs_error(FS_ERR_DATA, "[time] end >= 0 and min_step > 0 expected (got %g, %g)", st->time.end, st->time.min_step);
         return -1;
     }
     return fs_shrink_check(&st->shrink);
@@ -150,9 +113,9 @@ static double compute_ratios(const fs_springs *s, const double *x, double *ratio
 static void set_time(fs_springs *s, double t)
 {
     fs_spring_net *net = &s->net;
-    const fs_springs_setup *st = &s->setup;
+    const fs_model_setup *st = &s->setup;
     int dim = s->dim, L = s->layers;
-    double H = fs_material_thickness(&st->material, t, st->time_end);
+    double H = fs_material_thickness(&st->material, t, st->time.end);
     double top = fs_pwl_eval(&st->shrink.top, t), bottom = fs_pwl_eval(&st->shrink.bottom, t);
     double J[9];
     fs_growth_jacobian(&s->growth, 0.0, t, J);
@@ -308,7 +271,7 @@ int32_t fs_springs_fragments(const fs_springs *s, int32_t *label)
     return count;
 }
 
-int fs_springs_init(fs_springs *s, const fs_mesh *m, const fs_springs_setup *setup)
+int fs_springs_init(fs_springs *s, const fs_mesh *m, const fs_model_setup *setup)
 {
     memset(s, 0, sizeof *s);
     s->setup = *setup;
@@ -320,7 +283,7 @@ int fs_springs_init(fs_springs *s, const fs_mesh *m, const fs_springs_setup *set
         return -1;
     }
     const fs_domain *dom = &m->domain;
-    if (fs_growth_field_init(&s->growth, &setup->growth, NULL, dom, setup->time_end) < 0)
+    if (fs_growth_field_init(&s->growth, &setup->growth, NULL, dom, setup->time.end) < 0)
         return -1;
     if (fs_voronoi_build(m, &s->vor) < 0)
         return -1;
@@ -338,20 +301,8 @@ int fs_springs_init(fs_springs *s, const fs_mesh *m, const fs_springs_setup *set
     bool wrap_y = !sphere && dom->periodic_y;
     s->ext[0] = wrap_x ? fs_domain_extent_x(dom) : 0.0;
     s->ext[1] = wrap_y ? fs_domain_extent_y(dom) : 0.0;
-    bool wrap_u = fs_domain_wraps_u(dom), wrap_v = fs_domain_wraps_v(dom);
 
-    grey_map tmap, ymap, smap;
-    if (map_load(mat->thickness_map, &tmap) < 0)
-        return -1;
-    if (map_load(mat->young_map, &ymap) < 0) {
-        map_free(&tmap);
-        return -1;
-    }
-    if (map_load(mat->threshold_map, &smap) < 0) {
-        map_free(&tmap);
-        map_free(&ymap);
-        return -1;
-    }
+    const fs_grey_map *tmap = &setup->thickness_map, *ymap = &setup->young_map, *smap = &setup->threshold_map;
 
     size_t nm = (size_t)s->n_material + 1;
     s->rest0 = fs_calloc(nm, sizeof *s->rest0);
@@ -377,8 +328,8 @@ int fs_springs_init(fs_springs *s, const fs_mesh *m, const fs_springs_setup *set
     for (int32_t i = 0; i < n; i++) {
         double uv[2];
         point_uv(dom, m->pos + 3 * (size_t)i, uv);
-        s->thick[i] = map_sample(&tmap, uv, wrap_u, wrap_v);
-        young_g[i] = map_sample(&ymap, uv, wrap_u, wrap_v);
+        s->thick[i] = map_sample(tmap, uv);
+        young_g[i] = map_sample(ymap, uv);
         double area = fmax(s->vor.cell_area[i], 1e-3 * mean_area);
         /* anchor: E A / (shear_lag^2 H); inter-layer: G A / (H / L) */
         s->anchor_coef[i] = E * young_g[i] * area / (p->shear_lag * p->shear_lag * s->thick[i]);
@@ -412,7 +363,7 @@ int fs_springs_init(fs_springs *s, const fs_mesh *m, const fs_springs_setup *set
                 mid[q] *= dom->radius / (r > 0.0 ? r : 1.0);
         }
         point_uv(dom, mid, uv);
-        double gE = map_sample(&ymap, uv, wrap_u, wrap_v), gT = map_sample(&smap, uv, wrap_u, wrap_v);
+        double gE = map_sample(ymap, uv), gT = map_sample(smap, uv);
         double w = s->vor.edge_length[e];
         bool inert = a == b || !(l0 > 0.0);
         if (!(w >= 0.0))
@@ -435,9 +386,6 @@ int fs_springs_init(fs_springs *s, const fs_mesh *m, const fs_springs_setup *set
         }
     }
     free(young_g);
-    map_free(&tmap);
-    map_free(&ymap);
-    map_free(&smap);
 
     /* the network: material springs, inter-layer springs, anchors of the bottom layer */
     int32_t n_inter = (L - 1) * n;
@@ -477,7 +425,7 @@ int fs_springs_init(fs_springs *s, const fs_mesh *m, const fs_springs_setup *set
     for (int32_t e = 0; e < ne; e++)
         spacing += s->rest0[e];
     spacing /= ne > 0 ? ne : 1;
-    double lag = p->shear_lag * fs_material_thickness(mat, 0.0, setup->time_end);
+    double lag = p->shear_lag * fs_material_thickness(mat, 0.0, setup->time.end);
     double hops = spacing > 0.0 ? ceil(lag / spacing) + 3.0 : 6.0;
     net->local_radius = hops > 1e6 ? 1000000 : (int32_t)hops;
     net->screening = spacing > 0.0 ? fmin(lag / spacing, 1e6) : 3.0;
@@ -595,7 +543,7 @@ static double predict_event(fs_springs *s, double delta)
 
 int fs_springs_advance(fs_springs *s, double t_end)
 {
-    const fs_springs_setup *st = &s->setup;
+    const fs_model_setup *st = &s->setup;
     if (!isfinite(t_end) || t_end < s->time) {
         fs_error(FS_ERR_DATA, "springs: cannot advance from t = %g to %g", s->time, t_end);
         return -1;
@@ -607,7 +555,7 @@ int fs_springs_advance(fs_springs *s, double t_end)
     }
     if (cascade(s) < 0)
         return -1;
-    double min_step = st->min_step;
+    double min_step = st->time.min_step;
     double quality = 0.9; /* how far towards the predicted event to jump, adapted to the hits */
     double gap_hint = 0.01 * (t_end - s->time); /* the last time between events */
     while (s->time < t_end && !at_limit(s)) {
@@ -675,35 +623,30 @@ int fs_springs_advance(fs_springs *s, double t_end)
     return 0;
 }
 
-int fs_springs_run(const fs_mesh *m, const fs_springs_params *springs, const fs_material *material,
-                   const fs_growth *growth, const fs_shrink *shrink, double time_end, double min_step,
-                   uint64_t seed, fs_surface *surface, int64_t *fractures, double *simulated_time)
+fs_springs *fs_springs_create(const fs_mesh *mesh, const fs_model_setup *setup)
 {
-    fs_springs_setup setup;
-    memset(&setup, 0, sizeof setup);
-    setup.springs = *springs;
-    setup.material = *material;
-    setup.growth = *growth;
-    setup.shrink = *shrink;
-    setup.time_end = time_end;
-    setup.min_step = min_step;
-    setup.seed = seed;
-    fs_springs s;
-    double t0 = fs_seconds();
-    int rc = fs_springs_init(&s, m, &setup);
-    if (rc == 0)
-        rc = fs_springs_advance(&s, time_end);
-    double t1 = fs_seconds();
-    if (rc == 0) {
-        fs_progress("springs", -1, "3-D post-process of %d cells", (int)m->n_nodes);
-        rc = fs_springs_render(&s, surface);
+    fs_springs *s = fs_malloc(sizeof *s);
+    if (fs_springs_init(s, mesh, setup) < 0) {
+        fs_springs_free(s);
+        free(s);
+        return NULL;
     }
-    fs_debug("springs: %.2f s to t = %g (%d breaks), %.2f s post-process and render mesh", t1 - t0, s.time,
-             (int)s.break_count, fs_seconds() - t1);
-    if (fractures)
-        *fractures = s.break_count;
-    if (simulated_time)
-        *simulated_time = s.time;
-    fs_springs_free(&s);
-    return rc;
+    return s;
+}
+
+fs_model_info fs_springs_info(const fs_springs *s) { return (fs_model_info){s->break_count, s->time}; }
+
+void fs_springs_report(const fs_springs *s)
+{
+    fs_debug("springs: t = %g, %d breaks, %lld event-search evaluations, %lld Newton steps, %lld factorizations",
+             s->time, (int)s->break_count, (long long)s->evaluations, (long long)s->relax_steps,
+             (long long)s->net.factorizations);
+}
+
+void fs_springs_destroy(fs_springs *s)
+{
+    if (!s)
+        return;
+    fs_springs_free(s);
+    free(s);
 }

@@ -1,4 +1,4 @@
-/* The wedge model's fracture loop: element selection, removal or subdivision (Algorithm 8), adaptive time steps to the next event (Algorithm 5), and the run of fs_sim_run. */
+/* The wedge model's fracture loop: element selection, removal or subdivision (Algorithm 8), adaptive time steps to the next event (Algorithm 5), and the model interface. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,7 +8,7 @@
 #include "fracture/event.h"
 #include "fracture/rank.h"
 #include "geom/refine.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 /* Candidates of one subdivision batch, sorted by descending ratio, then ascending index. */
 typedef struct {
@@ -37,7 +37,7 @@ int fs_wedge_fracture(fs_wedge_model *w, int *removed)
     *removed = 0;
     if (!(fs_wedge_max_ratio(w) > 1.0))
         return 1;
-    int32_t pick = fs_rank_pick(w->ratio, NULL, w->n_elems, w->cfg.preset.seed);
+    int32_t pick = fs_rank_pick(w->ratio, NULL, w->n_elems, w->cfg.seed);
     FS_ASSERT(pick >= 0);
     double min_size = w->cfg.mesh.min_size;
     if (fs_refine_tri_size(w->mesh, pick) >= min_size) {
@@ -193,48 +193,58 @@ done:
     return rc < 0 ? -1 : 0;
 }
 
-int fs_wedge_run(const fs_config *cfg, fs_mesh *mesh, fs_surface *surface, fs_stats *stats)
+fs_wedge_model *fs_wedge_create(fs_mesh *mesh, const fs_model_setup *setup)
 {
-    fs_wedge_model w;
-    if (fs_wedge_init(&w, mesh, cfg) < 0)
-        return -1;
-    w.lazy_ratios = cfg->fracture.method == FS_FRACTURE_REMOVE;
-    int rc = fs_wedge_simulate(&w, cfg->time.end);
-    if (rc == 0)
-        rc = fs_wedge_render_mesh(&w, surface);
-    if (rc == 0) {
-        const fs_wedge_counters *c = &w.counters;
-        stats->fractures = w.fractures;
-        stats->simulated_time = w.time;
-        fs_debug("wedge: %lld splits, %lld tips retired by Griffith, %d tips left; relaxations %lld local, "
-                 "%lld global", (long long)w.fractures, (long long)w.griffith_stops, (int)w.n_tips,
-                 (long long)w.counters.local_relaxations, (long long)w.counters.global_fallbacks);
-        double per = c->event_relaxations ? 1e3 / (double)c->event_relaxations : 0.0;
-        fs_debug("wedge: %lld time steps, %lld event-search evaluations; %lld events with relaxation, %.2f ms each "
-                 "(%.2f ms relaxing); local relaxation %.2f s, %lld unknowns, %lld CG iterations, %lld retries",
-                 (long long)c->time_steps, (long long)c->search_evaluations, (long long)c->event_relaxations,
-                 per * c->event_seconds, per * c->event_relax_seconds, c->local_seconds, (long long)c->local_dofs,
-                 (long long)c->local_cg_iterations, (long long)c->relax_retries);
-        fs_debug("wedge: %lld removals, %lld subdivisions, %lld solves (%.2f s), %lld factorizations (%.2f s), "
-                 "%lld analyses (%.2f s), %lld updates (%.2f s), assembly %.2f s, stresses %.2f s, "
-                 "%lld CG iterations",
-                 (long long)c->removals, (long long)c->subdivisions, (long long)c->solves, c->solve_seconds,
-                 (long long)c->factorizations, c->factor_seconds, (long long)c->analyses, c->analyze_seconds,
-                 (long long)c->updowns, c->update_seconds, c->assemble_seconds, c->stress_seconds,
-                 (long long)c->cg_iterations);
-        if (cfg->mesh.refine_vm > 0.0)
-            fs_debug("wedge: von Mises refinement: %lld rounds, %lld bisections, %.2f s", (long long)c->vm_rounds,
-                     (long long)c->vm_bisections, c->vm_seconds);
-        if (cfg->fracture.tip_submodel)
-            fs_debug("wedge: tip sub-models: %lld, %.0f elements each, %lld found the tip below its threshold, "
-                     "%.2f s (%.2f ms each)", (long long)c->submodels,
-                     c->submodels ? (double)c->submodel_elements / (double)c->submodels : 0.0,
-                     (long long)c->submodel_rejections, c->submodel_seconds,
-                     c->submodels ? 1e3 * c->submodel_seconds / (double)c->submodels : 0.0);
-        if (cfg->mesh.smooth_radius > 0.0)
-            fs_debug("wedge: smoothing: %lld passes, %lld nodes moved, %.2f s", (long long)c->smoothings,
-                     (long long)c->smoothed_nodes, c->smooth_seconds);
+    fs_wedge_model *w = fs_malloc(sizeof *w);
+    if (fs_wedge_init(w, mesh, setup) < 0) {
+        free(w);
+        return NULL;
     }
-    fs_wedge_free(&w);
-    return rc;
+    return w;
+}
+
+int fs_wedge_advance(fs_wedge_model *w, double t) { return fs_wedge_simulate(w, t); }
+
+fs_model_info fs_wedge_info(const fs_wedge_model *w) { return (fs_model_info){w->fractures, w->time}; }
+
+void fs_wedge_report(const fs_wedge_model *w)
+{
+    const fs_wedge_counters *c = &w->counters;
+    const fs_model_setup *cfg = &w->cfg;
+    fs_debug("wedge: %lld splits, %lld tips retired by Griffith, %d tips left; relaxations %lld local, "
+             "%lld global", (long long)w->fractures, (long long)w->griffith_stops, (int)w->n_tips,
+             (long long)c->local_relaxations, (long long)c->global_fallbacks);
+    double per = c->event_relaxations ? 1e3 / (double)c->event_relaxations : 0.0;
+    fs_debug("wedge: %lld time steps, %lld event-search evaluations; %lld events with relaxation, %.2f ms each "
+             "(%.2f ms relaxing); local relaxation %.2f s, %lld unknowns, %lld CG iterations, %lld retries",
+             (long long)c->time_steps, (long long)c->search_evaluations, (long long)c->event_relaxations,
+             per * c->event_seconds, per * c->event_relax_seconds, c->local_seconds, (long long)c->local_dofs,
+             (long long)c->local_cg_iterations, (long long)c->relax_retries);
+    fs_debug("wedge: %lld removals, %lld subdivisions, %lld solves (%.2f s), %lld factorizations (%.2f s), "
+             "%lld analyses (%.2f s), %lld updates (%.2f s), assembly %.2f s, stresses %.2f s, "
+             "%lld CG iterations",
+             (long long)c->removals, (long long)c->subdivisions, (long long)c->solves, c->solve_seconds,
+             (long long)c->factorizations, c->factor_seconds, (long long)c->analyses, c->analyze_seconds,
+             (long long)c->updowns, c->update_seconds, c->assemble_seconds, c->stress_seconds,
+             (long long)c->cg_iterations);
+    if (cfg->mesh.refine_vm > 0.0)
+        fs_debug("wedge: von Mises refinement: %lld rounds, %lld bisections, %.2f s", (long long)c->vm_rounds,
+                 (long long)c->vm_bisections, c->vm_seconds);
+    if (cfg->fracture.tip_submodel)
+        fs_debug("wedge: tip sub-models: %lld, %.0f elements each, %lld found the tip below its threshold, "
+                 "%.2f s (%.2f ms each)", (long long)c->submodels,
+                 c->submodels ? (double)c->submodel_elements / (double)c->submodels : 0.0,
+                 (long long)c->submodel_rejections, c->submodel_seconds,
+                 c->submodels ? 1e3 * c->submodel_seconds / (double)c->submodels : 0.0);
+    if (cfg->mesh.smooth_radius > 0.0)
+        fs_debug("wedge: smoothing: %lld passes, %lld nodes moved, %.2f s", (long long)c->smoothings,
+                 (long long)c->smoothed_nodes, c->smooth_seconds);
+}
+
+void fs_wedge_destroy(fs_wedge_model *w)
+{
+    if (!w)
+        return;
+    fs_wedge_free(w);
+    free(w);
 }

@@ -6,7 +6,7 @@
 #include <math.h>
 
 #include "base/vec.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 /* The tangent plane at a node: the flat frame's x and y, or on the sphere a right-handed pair
  * (e1, e2, normal), so triangles counter-clockwise from outside are counter-clockwise in it. */

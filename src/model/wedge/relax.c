@@ -6,7 +6,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "base/sort.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 #include "solve/cg.h"
 #include "solve/sparse.h"
 

@@ -9,7 +9,7 @@
 #include "fracture/rank.h"
 #include "fracture/split.h"
 #include "geom/refine.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 #include "model/wedge/frame.h"
 
 /* design: thesis §5.7. The layer is a surface mesh extruded into wedge columns, and a crack always
@@ -888,7 +888,7 @@ static int32_t pick_tip(const fs_wedge_model *w, const uint8_t *tried)
             r[k] = NAN;
         id[k] = (uint64_t)w->tip_node[k];
     }
-    int32_t k = fs_rank_pick(r, id, w->n_tips, w->cfg.preset.seed);
+    int32_t k = fs_rank_pick(r, id, w->n_tips, w->cfg.seed);
     free(r);
     free(id);
     return k;
@@ -968,7 +968,7 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed)
             if (!(r[i] > 1.0))
                 r[i] = NAN;
         }
-        pick = fs_rank_pick(r, NULL, w->n_nodes, w->cfg.preset.seed);
+        pick = fs_rank_pick(r, NULL, w->n_nodes, w->cfg.seed);
         free(r);
     }
     if (pick < 0)

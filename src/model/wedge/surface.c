@@ -7,7 +7,7 @@
 #include "base/log.h"
 #include "base/rng.h"
 #include "base/vec.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 #include "geom/sphere_surface.h"
 
 /* Sphere: largest uv deviation of a chord's midpoint image from the mean of its ends' images
@@ -139,7 +139,7 @@ static void emit_tri(render_ctx *r, const double p[3][3], const attr a[3])
 
 static attr top_attr(const render_ctx *r, int32_t e, int32_t node)
 {
-    double shade = 2.0 * fs_rand01(r->w->cfg.preset.seed, FS_RNG_CELL_COLOR, (uint64_t)r->label[e]) - 1.0;
+    double shade = 2.0 * fs_rand01(r->w->cfg.seed, FS_RNG_CELL_COLOR, (uint64_t)r->label[e]) - 1.0;
     return (attr){top_height(r->w, node), 0.0, (double)(r->label[e] % 65535 + 1), shade};
 }
 
@@ -1067,7 +1067,7 @@ static int split_render_mesh(render_ctx *r)
     return 0;
 }
 
-int fs_wedge_render_mesh(const fs_wedge_model *w, fs_surface *out)
+int fs_wedge_surface(const fs_wedge_model *w, fs_surface *out)
 {
     memset(out, 0, sizeof *out);
     const fs_mesh *m = w->mesh;

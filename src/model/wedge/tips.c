@@ -9,7 +9,7 @@
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "geom/refine.h"
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 #include "model/wedge/frame.h"
 
 /* Refinement passes of a sub-model around its tip (each bisects the tip's vicinity once, with
@@ -317,8 +317,8 @@ int fs_wedge_tip_submodel(fs_wedge_model *w, int32_t node, double radius, double
             inf.tip_size = fmax(inf.tip_size, fs_refine_tri_size(&sm, t));
 
     /* 4. the sub-model, assembled and factorized once its data are in */
-    fs_config c = w->cfg;
-    c.material.thickness_map[0] = c.material.young_map[0] = c.material.threshold_map[0] = '\0';
+    fs_model_setup c = w->cfg;
+    c.thickness_map = c.young_map = c.threshold_map = (fs_grey_map){0};
     c.material.jitter = 0.0;
     c.wedge.thickness_gradient = 0.0;
     c.solver.method = FS_SOLVER_CHOLMOD;

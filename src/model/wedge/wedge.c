@@ -1,5 +1,5 @@
 /* The wedge model's layer: geometry and materials from the mesh, sparse assembly, equilibrium (CHOLMOD or CG) and element stresses. */
-#include "model/wedge/wedge.h"
+#include "model/wedge/internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -13,7 +13,6 @@
 #include "fracture/eigen.h"
 #include "fracture/rank.h"
 #include "geom/refine.h"
-#include "image/image.h"
 #include "model/wedge/element.h"
 #include "solve/cg.h"
 
@@ -22,66 +21,18 @@
 
 /* ---- grey-level maps (thesis §5.9) ---- */
 
-typedef struct {
-    int width, height;
-    float *grey;
-    bool wrap_u, wrap_v;
-} grey_map;
-
-static int map_load(const char *path, const fs_domain *d, grey_map *m)
-{
-    memset(m, 0, sizeof *m);
-    if (!path[0])
-        return 0;
-    if (fs_image_read_grey(path, &m->width, &m->height, &m->grey) < 0)
-        return -1;
-    m->wrap_u = fs_domain_wraps_u(d);
-    m->wrap_v = fs_domain_wraps_v(d);
-    return 0;
-}
-
-static void map_free(grey_map *m)
-{
-    free(m->grey);
-    memset(m, 0, sizeof *m);
-}
-
-/* Pixel index along one axis: wrapped or clamped. */
-static int map_index(int i, int n, bool wrap)
-{
-    if (wrap) {
-        i %= n;
-        return i < 0 ? i + n : i;
-    }
-    return i < 0 ? 0 : i >= n ? n - 1 : i;
-}
-
-/* Bilinear grey value at texture coordinates (u, v), v up (render.h's pixel convention). */
-static double map_sample(const grey_map *m, double u, double v)
-{
-    double fx = u * m->width - 0.5, fy = (1.0 - v) * m->height - 0.5;
-    double x0 = floor(fx), y0 = floor(fy);
-    double ax = fx - x0, ay = fy - y0;
-    int i0 = map_index((int)x0, m->width, m->wrap_u), i1 = map_index((int)x0 + 1, m->width, m->wrap_u);
-    int j0 = map_index((int)y0, m->height, m->wrap_v), j1 = map_index((int)y0 + 1, m->height, m->wrap_v);
-    const float *g = m->grey;
-    double top = g[(size_t)j0 * m->width + i0] * (1.0 - ax) + g[(size_t)j0 * m->width + i1] * ax;
-    double bot = g[(size_t)j1 * m->width + i0] * (1.0 - ax) + g[(size_t)j1 * m->width + i1] * ax;
-    return top * (1.0 - ay) + bot * ay;
-}
-
 /* The map factor at a domain point (unwrapped coordinates are fine: the map wraps with the domain). */
-static double map_at(const grey_map *m, const fs_domain *d, const double *p)
+static double map_at(const fs_grey_map *m, const fs_domain *d, const double *p)
 {
     if (!m->grey)
         return 1.0;
     double uv[2];
     fs_domain_to_uv(d, p, uv);
-    return fmax(map_sample(m, uv[0], uv[1]), MAP_FLOOR);
+    return fmax(fs_grey_map_sample(m, uv[0], uv[1]), MAP_FLOOR);
 }
 
 /* A map averaged over a triangle: its centroid and the three interior points (2/3, 1/6, 1/6). */
-static double map_average(const grey_map *m, const fs_domain *d, const double corner[3][3])
+static double map_average(const fs_grey_map *m, const fs_domain *d, const double corner[3][3])
 {
     if (!m->grey)
         return 1.0;
@@ -111,7 +62,7 @@ static double layer_thickness(const fs_wedge_model *w, double t)
 }
 
 /* Nodal thickness factor: the thickness map at the node and the linear gradient across u. */
-static double node_thickness_factor(const fs_wedge_model *w, const grey_map *tmap, int32_t i)
+static double node_thickness_factor(const fs_wedge_model *w, const fs_grey_map *tmap, int32_t i)
 {
     const fs_domain *d = &w->mesh->domain;
     const double *p = w->mesh->pos + 3 * (size_t)i;
@@ -839,10 +790,19 @@ static int solve(fs_wedge_model *w)
             p.block = 3; /* a node's three unknowns are consecutive (number_dofs) */
         }
         int it = fs_cg_solve(&w->k_free, w->rhs, w->x, p, NULL);
-        if (it < 0)
-            rc = -1;
-        else
+        if (it >= 0) {
             w->counters.cg_iterations += it;
+        } else if (w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
+            /* CG can stall on a mesh that many cuts have left ill-conditioned: a fresh analysis (the
+             * pattern has changed since the factor) and factorization, and the direct solve */
+            fs_debug("wedge: %s; solving with a fresh factorization", fs_error_message());
+            fs_error_clear();
+            rc = factorize(w, true);
+            if (rc == 0)
+                rc = fs_cholesky_solve(w->chol, 1, w->rhs, w->x);
+        } else {
+            rc = -1;
+        }
     }
     w->counters.solves++;
     w->counters.solve_seconds += fs_seconds() - t0;
@@ -1250,14 +1210,14 @@ int fs_wedge_nodal_stress(const fs_wedge_model *w, int32_t node, bool top, doubl
 /* ---- construction ---- */
 
 /* Per-element materials: Young's modulus and threshold with their maps, threshold jitter by element id. */
-static void element_materials(fs_wedge_model *w, int32_t e, const grey_map *ymap, const grey_map *tmap)
+static void element_materials(fs_wedge_model *w, int32_t e, const fs_grey_map *ymap, const fs_grey_map *tmap)
 {
     const fs_material *mat = &w->cfg.material;
     double corner[3][3];
     for (int c = 0; c < 3; c++)
         fs_mesh_corner(w->mesh, e, c, corner[c]);
     w->young[e] = mat->young * map_average(ymap, &w->mesh->domain, corner);
-    double jitter = 1.0 + mat->jitter * (2.0 * fs_rand01(w->cfg.preset.seed, FS_RNG_JITTER, (uint64_t)e) - 1.0);
+    double jitter = 1.0 + mat->jitter * (2.0 * fs_rand01(w->cfg.seed, FS_RNG_JITTER, (uint64_t)e) - 1.0);
     w->threshold[e] = 1e-3 * mat->threshold * jitter * map_average(tmap, &w->mesh->domain, corner);
 }
 
@@ -1305,13 +1265,14 @@ static void grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
 }
 
 /* fs_wedge_init, with the assembly and factorization left out unless assemble is set. */
-static int init_model(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg, bool assemble)
+static int init_model(fs_wedge_model *w, fs_mesh *mesh, const fs_model_setup *cfg, bool assemble)
 {
     memset(w, 0, sizeof *w);
     w->mesh = mesh;
     w->cfg = *cfg;
     if (cfg->solver.relax == FS_RELAX_AUTO) /* see fs_solver_params and thesis §5.8 */
         w->cfg.solver.relax = FS_RELAX_LOCAL;
+    w->lazy_ratios = cfg->fracture.method == FS_FRACTURE_REMOVE;
     fs_domain_normalize(&w->mesh->domain);
     const fs_domain *d = &mesh->domain;
     w->flat = d->type != FS_DOMAIN_SPHERE;
@@ -1335,22 +1296,11 @@ static int init_model(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg, bo
     else
         w->growth_mode = FS_WEDGE_GROWTH_MOVE;
 
-    grey_map thick = {0}, ymap = {0}, tmap = {0};
-    if (map_load(cfg->material.thickness_map, d, &thick) < 0 || map_load(cfg->material.young_map, d, &ymap) < 0 ||
-        map_load(cfg->material.threshold_map, d, &tmap) < 0) {
-        map_free(&thick);
-        map_free(&ymap);
-        fs_wedge_free(w);
-        return -1;
-    }
     grow_arrays(w, mesh->n_nodes, mesh->n_tris);
     for (int32_t i = 0; i < w->n_nodes; i++)
-        w->thickness_factor[i] = node_thickness_factor(w, &thick, i);
+        w->thickness_factor[i] = node_thickness_factor(w, &cfg->thickness_map, i);
     for (int32_t e = 0; e < w->n_elems; e++)
-        element_materials(w, e, &ymap, &tmap);
-    map_free(&thick);
-    map_free(&ymap);
-    map_free(&tmap);
+        element_materials(w, e, &cfg->young_map, &cfg->threshold_map);
 
     w->assembled_thickness = layer_thickness(w, 0.0);
     if (assemble && build_system(w) < 0) {
@@ -1360,12 +1310,12 @@ static int init_model(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg, bo
     return 0;
 }
 
-int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg)
+int fs_wedge_init(fs_wedge_model *w, fs_mesh *mesh, const fs_model_setup *cfg)
 {
     return init_model(w, mesh, cfg, true);
 }
 
-int fs_wedge_init_unassembled(fs_wedge_model *w, fs_mesh *mesh, const fs_config *cfg)
+int fs_wedge_init_unassembled(fs_wedge_model *w, fs_mesh *mesh, const fs_model_setup *cfg)
 {
     return init_model(w, mesh, cfg, false);
 }
@@ -2032,3 +1982,5 @@ double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e)
     }
     return 0.5 * energy;
 }
+
+fs_wedge_params fs_wedge_params_default(void) { return (fs_wedge_params){.thickness_gradient = 0.0}; }
