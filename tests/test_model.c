@@ -97,7 +97,7 @@ static void run_physical(fs_model_kind kind, fs_fracture_method method)
 {
     const char *name = fs_model_name(kind);
     fs_mesh m = {0};
-    CHECK(tiny_mesh(kind == FS_MODEL_WEDGE ? 150 : 300, &m) == 0);
+    CHECK(tiny_mesh(kind == FS_MODEL_SPRINGS ? 300 : 150, &m) == 0);
     fs_model_setup s = shrinking_layer(kind);
     s.fracture.method = method;
     fs_model model;
@@ -129,6 +129,7 @@ static void run_physical(fs_model_kind kind, fs_fracture_method method)
 static void test_springs(void) { run_physical(FS_MODEL_SPRINGS, FS_FRACTURE_SPLIT); }
 static void test_wedge_split(void) { run_physical(FS_MODEL_WEDGE, FS_FRACTURE_SPLIT); }
 static void test_wedge_remove(void) { run_physical(FS_MODEL_WEDGE, FS_FRACTURE_REMOVE); }
+static void test_tet(void) { run_physical(FS_MODEL_TET, FS_FRACTURE_SPLIT); }
 
 /* Kinds this build does not have and bad parameters fail cleanly, with a data error naming the key. */
 static void test_refusals(void)
@@ -266,6 +267,7 @@ int main(void)
     RUN(test_springs);
     RUN(test_wedge_split);
     RUN(test_wedge_remove);
+    RUN(test_tet);
     RUN(test_refusals);
     RUN(test_sim_frames);
     RUN(test_sim_one_frame);

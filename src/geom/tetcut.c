@@ -200,6 +200,9 @@ typedef struct {
     int side;
 } star_corner;
 
+/* Edges are cut no nearer their ends than this fraction (snap_near_crossings). */
+#define EDGE_MIN 0.2
+
 static star_corner *find_corner(star_corner *cs, int32_t n, int32_t node)
 {
     for (int32_t i = 0; i < n; i++)
@@ -235,6 +238,38 @@ static int32_t classify(const fs_tetmesh *m, int32_t node, const double nrm[3], 
     return n_cs;
 }
 
+/* The paper's thresholds keep the cut points away from the splitting node's corners; they do not keep
+ * a cut point from landing next to the corner at the near end of a long edge, whose halves would be
+ * a sliver. So an edge is cut only between EDGE_MIN and 1 - EDGE_MIN of its length: a corner nearer
+ * than that to where the plane crosses one of its edges is taken as on the plane too, until no such
+ * crossing is left. */
+static void snap_near_crossings(const fs_tetmesh *m, int32_t node, star_corner *cs, int32_t n_cs)
+{
+    const fs_tet_list *star = &m->node_tets[node];
+    for (bool changed = true; changed;) {
+        changed = false;
+        for (int32_t k = 0; k < star->n; k++) {
+            const int32_t *v = m->tet + 4 * (size_t)star->v[k];
+            for (int c1 = 0; c1 < 4; c1++)
+                for (int c2 = c1 + 1; c2 < 4; c2++) {
+                    if (v[c1] == node || v[c2] == node)
+                        continue;
+                    star_corner *k1 = find_corner(cs, n_cs, v[c1]), *k2 = find_corner(cs, n_cs, v[c2]);
+                    if (k1->side * k2->side >= 0)
+                        continue;
+                    double w = k1->d / (k1->d - k2->d);
+                    if (w < EDGE_MIN) {
+                        k1->side = 0;
+                        changed = true;
+                    } else if (w > 1.0 - EDGE_MIN) {
+                        k2->side = 0;
+                        changed = true;
+                    }
+                }
+        }
+    }
+}
+
 int fs_tetcut_sides(const fs_tetmesh *m, int32_t node, const double normal[3], const fs_tetcut_params *p)
 {
     double len = fs_norm3(normal);
@@ -244,6 +279,7 @@ int fs_tetcut_sides(const fs_tetmesh *m, int32_t node, const double normal[3], c
     int32_t cap = 3 * m->node_tets[node].n + 8;
     star_corner buf[192], *cs = cap <= 192 ? buf : fs_malloc((size_t)cap * sizeof *cs);
     int32_t n = classify(m, node, nrm, p, cs);
+    snap_near_crossings(m, node, cs, n);
     int sides = 0;
     for (int32_t i = 0; i < n; i++)
         sides |= cs[i].side > 0 ? 1 : (cs[i].side < 0 ? 2 : 0);
@@ -277,6 +313,7 @@ int fs_tetcut_node(fs_tetmesh *m, int32_t node, const double normal[3], const fs
     int32_t cap_cs = 4 * star.n + 8;
     star_corner *cs = fs_malloc((size_t)cap_cs * sizeof *cs);
     int32_t n_cs = classify(m, node, nrm, p, cs);
+    snap_near_crossings(m, node, cs, n_cs);
     int sides = 0;
     for (int32_t i = 0; i < n_cs; i++)
         sides |= cs[i].side > 0 ? 1 : (cs[i].side < 0 ? 2 : 0);

@@ -8,7 +8,9 @@
 
 /* The snapping of O'Brien & Hodgins §4.3 (they used 5 mm and 0.1 rad): a corner of an element at the
  * node is taken to lie on the fracture plane when it is nearer the plane than snap_distance, or when
- * the line from the node to it makes an angle smaller than snap_angle with the plane. */
+ * the line from the node to it makes an angle smaller than snap_angle with the plane. Besides, an
+ * edge is never cut within a fifth of its length from an end: that end is taken as on the plane
+ * instead (else the halves of a long edge cut next to its end are slivers). */
 typedef struct {
     double snap_distance; /* cm */
     double snap_angle;    /* radians */

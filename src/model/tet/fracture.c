@@ -82,6 +82,8 @@ double fs_tet_node_ratio(const fs_tet *s, int32_t i, const double *c, int *kind,
     fs_separation_tensor(&sep, zeta);
     fs_separation_eigen(zeta, value, vec);
     *kind = 0;
+    if (normal)
+        normal[0] = normal[1] = normal[2] = 0.0;
     for (int e = 0; e < 3 && value[e] > 0.0; e++) {
         const double *n = vec + 3 * e;
         if (fs_tetcut_sides(&s->mesh, i, n, &s->snap) != 3)
@@ -305,7 +307,8 @@ static void stiffness_block(const fs_tet *s, int32_t t, int a, int b, double k[9
  * unknowns node by node), node by node from the node's elements, without the general builder's sort:
  * a relaxation is all of an event's solving and is repeated thousands of times. The system is solved
  * by conjugate gradients with 3 x 3 block preconditioning (solve/cg.h): it is small, well conditioned
- * (its boundary is held), and a direct factor of a compact 3-D region fills in almost completely. */
+ * (its boundary is held), and a direct factor of a compact 3-D region fills in almost completely; a
+ * region holding a piece that came off is solved by a direct factor instead. */
 static int solve_region(fs_tet *s, const int32_t *region, int32_t nr, const int32_t *tets, int32_t nt)
 {
     int nl = s->n_loads;
@@ -426,6 +429,14 @@ static int solve_region(fs_tet *s, const int32_t *region, int32_t nr, const int3
         for (int k = 0; k < nl && rc == 0; k++)
             if (fs_cg_solve(&K, rhs + (size_t)k * n, x + (size_t)k * n, cp, NULL) < 0)
                 rc = -1;
+        if (rc < 0) {
+            /* a piece that came off altogether is held only by the regularising springs: too badly
+             * conditioned for the iteration, not for a direct factor */
+            fs_cholesky *chol = fs_cholesky_analyze_small(&K);
+            rc = !chol || fs_cholesky_factorize(chol, &K) < 0 || fs_cholesky_solve(chol, nl, rhs, x) < 0 ? -1 : 0;
+            fs_cholesky_free(chol);
+            s->counters.direct_solves++;
+        }
         if (rc == 0)
             for (int32_t ln = 0; ln < m; ln++)
                 for (int k = 0; k < nl; k++)
@@ -719,8 +730,16 @@ int fs_tet_advance(fs_tet *s, double t)
             continue;
         }
         int32_t i = cand[pick], kind;
-        double normal[3];
-        fs_tet_node_ratio(s, i, s->proportional ? NULL : c, &kind, normal);
+        double normal[3] = {0.0, 0.0, 0.0};
+        double fresh = fs_tet_node_ratio(s, i, s->proportional ? NULL : c, &kind, normal);
+        if (s->proportional)
+            fresh *= fs_tet_alpha(s, s->time);
+        if (!(fresh > 1.0)) {
+            /* its elements moved a little since its search (below SEARCH_AGAIN): search it again */
+            if ((rc = fs_tet_search_node(s, i, s->time)) < 0)
+                break;
+            continue;
+        }
         s->events++;
         if (kind == 1) {
             rc = fs_tet_debond(s, i);

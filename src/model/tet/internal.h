@@ -42,7 +42,7 @@ typedef struct {
 typedef struct {
     int64_t splits, debonds, failed_splits;
     int64_t searches, evaluations; /* per-node event searches and ratio evaluations */
-    int64_t local_solves, local_unknowns, global_solves;
+    int64_t local_solves, local_unknowns, global_solves, direct_solves;
     double mesh_seconds, solve_seconds, local_seconds, search_seconds, cut_seconds;
 } fs_tet_counters;
 
@@ -83,7 +83,7 @@ struct fs_tet {
     double *r_ref;              /* per node, proportional loads: its ratio at c_ref */
     fs_tetcut_params snap;      /* the cuts' snapping (cm, radians) */
     double reg;                 /* a spring to the rest position on every free unknown (MPa cm),
-                                   a billionth of an element's stiffness: no piece can float */
+                                   a millionth of an element's stiffness: no piece can float */
 
     fs_tetcut_result cut;       /* scratch of the last cut */
     int32_t *stamp;             /* scratch per node: the relaxation's marks (compared with stamp_now) */

@@ -18,11 +18,11 @@
 /* Automatic layer counts stay within these. */
 #define AUTO_LAYERS_MAX 6
 /* The spring on every free unknown, relative to an element's stiffness E * edge. */
-#define REG_RELATIVE 1e-9
+#define REG_RELATIVE 1e-6
 
 fs_tet_params fs_tet_params_default(void)
 {
-    fs_tet_params p = {.layers = 0, .snap_distance = 0.1, .snap_angle = 5.729577951308232, .bond = 0.0,
+    fs_tet_params p = {.layers = 0, .snap_distance = 0.3, .snap_angle = 5.729577951308232, .bond = 0.0,
                        .max_events = 0};
     return p;
 }
@@ -691,9 +691,10 @@ void fs_tet_report(const fs_tet *s)
     fs_debug("tet: %lld splits (%lld found no plane), %lld bonds came loose; %d nodes, %d tetrahedra now",
              (long long)c->splits, (long long)c->failed_splits, (long long)c->debonds, (int)s->mesh.n_nodes,
              (int)s->mesh.n_tets);
-    fs_debug("tet: %lld node searches (%lld ratio evaluations), %lld local solves (%.1f unknowns on average), %lld "
-             "global", (long long)c->searches, (long long)c->evaluations, (long long)c->local_solves,
-             c->local_solves ? (double)c->local_unknowns / (double)c->local_solves : 0.0, (long long)c->global_solves);
+    fs_debug("tet: %lld node searches (%lld ratio evaluations), %lld local solves (%.1f unknowns on average, %lld "
+             "by a direct factor), %lld global", (long long)c->searches, (long long)c->evaluations,
+             (long long)c->local_solves, c->local_solves ? (double)c->local_unknowns / (double)c->local_solves : 0.0,
+             (long long)c->direct_solves, (long long)c->global_solves);
     fs_debug("tet: seconds: set-up %.2f, global solves %.2f, local solves %.2f, searches %.2f, cuts %.2f",
              c->mesh_seconds, c->solve_seconds, c->local_seconds, c->search_seconds, c->cut_seconds);
 }
