@@ -83,7 +83,7 @@ struct fs_tet {
     double *r_ref;              /* per node, proportional loads: its ratio at c_ref */
     fs_tetcut_params snap;      /* the cuts' snapping (cm, radians) */
     double reg;                 /* a spring to the rest position on every free unknown (MPa cm),
-                                   a millionth of an element's stiffness: no piece can float */
+                                   a billionth of an element's stiffness: no piece can float */
 
     fs_tetcut_result cut;       /* scratch of the last cut */
     int32_t *stamp;             /* scratch per node: the relaxation's marks (compared with stamp_now) */

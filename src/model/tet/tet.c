@@ -18,7 +18,7 @@
 /* Automatic layer counts stay within these. */
 #define AUTO_LAYERS_MAX 6
 /* The spring on every free unknown, relative to an element's stiffness E * edge. */
-#define REG_RELATIVE 1e-6
+#define REG_RELATIVE 1e-9
 
 fs_tet_params fs_tet_params_default(void)
 {
