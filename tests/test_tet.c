@@ -6,6 +6,8 @@
 #include "base/rng.h"
 #include "base/vec.h"
 #include "check.h"
+#include "fracture/eigen.h"
+#include "geom/delaunay.h"
 #include "geom/sample.h"
 #include "geom/tetmesh.h"
 #include "model/tet/element.h"
@@ -345,6 +347,79 @@ static void test_bilayer(void)
     CHECK(em < ec && ef < em);
 }
 
+/* A strip bonded to a substrate stretched along x breaks across the stretch: the walls of its cracks
+ * face along x (their mean orientation, the principal axis of the area-weighted sum of n n^T, within 5
+ * degrees: single faces zigzag where the cut snapped to existing nodes). */
+static void test_strip_breaks_across(void)
+{
+    fs_domain d = fs_domain_default();
+    d.width = 6.0;
+    d.height = 2.0;
+    fs_domain_normalize(&d);
+    fs_sample_params sp = fs_sample_params_default();
+    sp.count = 300;
+    sp.seed = 3;
+    fs_points pts = {0};
+    fs_mesh mesh = {0};
+    CHECK(fs_sample_repulsion(&d, &sp, &pts) == 0 && fs_delaunay(&d, &pts, &mesh) == 0);
+    fs_points_free(&pts);
+    fs_model_setup cfg = setup_for(10.0, 0.3);
+    cfg.seed = 4;
+    cfg.material.threshold = 50.0;
+    cfg.material.thickness = 0.3;
+    cfg.growth.type = FS_GROWTH_PLANAR;
+    cfg.growth.r1 = 0.02;
+    cfg.growth.r2 = 0.0;
+    cfg.growth.angle = 0.0;
+    cfg.time.min_step = 1e-3;
+    cfg.tet.max_events = 40;
+    fs_tet *s = fs_tet_create(&mesh, &cfg);
+    CHECK(s != NULL);
+    if (!s) {
+        fs_mesh_free(&mesh);
+        return;
+    }
+    CHECK(fs_tet_advance(s, 1.0) == 0);
+    CHECK(s->counters.splits > 10);
+    int32_t *adj = malloc((4 * (size_t)s->mesh.n_tets + 1) * sizeof *adj);
+    fs_tetmesh_adjacency(&s->mesh, adj);
+    double nn[9] = {0}, area = 0.0;
+    for (int32_t h = 0; h < 4 * s->mesh.n_tets; h++) {
+        if (adj[h] >= 0)
+            continue;
+        const int *f = fs_tet_face[h % 4];
+        int inside = 0;
+        for (int k = 0; k < 3; k++) {
+            int32_t v = s->mesh.tet[4 * (size_t)(h / 4) + f[k]];
+            const double *p = s->mesh.pos + 3 * (size_t)v;
+            inside += s->mesh.zeta[v] > 0.0 && s->mesh.zeta[v] < 1.0 && p[0] > 0.0 && p[0] < 6.0 && p[1] > 0.0 &&
+                      p[1] < 2.0;
+        }
+        if (inside == 0)
+            continue; /* top, bottom and the strip's sides */
+        double x[12], e1[3], e2[3], n[3];
+        fs_tetmesh_corners(&s->mesh, h / 4, x);
+        fs_sub3(e1, x + 3 * f[1], x + 3 * f[0]);
+        fs_sub3(e2, x + 3 * f[2], x + 3 * f[0]);
+        fs_cross3(n, e1, e2);
+        double a = fs_norm3(n);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                nn[3 * i + j] += n[i] * n[j] / a;
+        area += a;
+    }
+    free(adj);
+    CHECK(area > 0.0);
+    double val[3], vec[9];
+    fs_eigen_sym3(nn, val, vec);
+    double angle = acos(fmin(fabs(vec[0]), 1.0)) * 180.0 / FS_PI;
+    printf("strip: %lld splits, crack walls %.2f degrees off the stretch's normal plane on average\n",
+           (long long)s->counters.splits, angle);
+    CHECK(angle < 5.0);
+    fs_tet_destroy(s);
+    fs_mesh_free(&mesh);
+}
+
 int main(void)
 {
     RUN(test_rigid_modes);
@@ -352,5 +427,6 @@ int main(void)
     RUN(test_patch);
     RUN(test_bonded_layer);
     RUN(test_bilayer);
+    RUN(test_strip_breaks_across);
     return check_finish();
 }
