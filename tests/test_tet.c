@@ -347,6 +347,65 @@ static void test_bilayer(void)
     CHECK(em < ec && ef < em);
 }
 
+static int cmp_edge(const void *a, const void *b)
+{
+    const int64_t *x = a, *y = b;
+    return (*x > *y) - (*x < *y);
+}
+
+/* The closed pieces of a cracked layer: every edge of the solid is used as often one way as the other
+ * (closed and consistently oriented), and the pieces enclose the layer's volume. */
+static void check_solid_closed(const fs_tet *s)
+{
+    fs_solid solid = {0};
+    CHECK(fs_tet_solid(s, &solid) == 0);
+    CHECK(solid.n_tris > 0);
+    int64_t *e = malloc((3 * (size_t)solid.n_tris + 1) * sizeof *e);
+    for (int32_t f = 0; f < solid.n_tris; f++)
+        for (int k = 0; k < 3; k++) {
+            int64_t a = solid.tri[3 * f + k], b = solid.tri[3 * f + (k + 1) % 3];
+            e[3 * f + k] = a * 2 * (int64_t)solid.n_pos + b;
+        }
+    qsort(e, 3 * (size_t)solid.n_tris, sizeof *e, cmp_edge);
+    /* each directed edge as often as its opposite (twice each way where a crack pinches a piece
+     * along an edge it did not cut) */
+    int32_t unmatched = 0, n_e = 3 * solid.n_tris;
+    for (int32_t q = 0; q < n_e;) {
+        int32_t r = q;
+        while (r < n_e && e[r] == e[q])
+            r++;
+        int64_t a = e[q] / (2 * (int64_t)solid.n_pos), b = e[q] % (2 * (int64_t)solid.n_pos);
+        int64_t back = b * 2 * (int64_t)solid.n_pos + a;
+        int64_t *hit = bsearch(&back, e, (size_t)n_e, sizeof *e, cmp_edge);
+        int32_t opposite = 0;
+        if (hit) {
+            int64_t *lo = hit, *hi = hit;
+            while (lo > e && lo[-1] == back)
+                lo--;
+            while (hi + 1 < e + n_e && hi[1] == back)
+                hi++;
+            opposite = (int32_t)(hi - lo + 1);
+        }
+        unmatched += opposite != r - q;
+        q = r;
+    }
+    free(e);
+    CHECK_MSG(unmatched == 0, "%d directed edges not matched by as many opposite ones", (int)unmatched);
+    /* the enclosed volume (divergence theorem) is the layer's, up to the displacements */
+    double vol = 0.0, want = 0.0;
+    for (int32_t f = 0; f < solid.n_tris; f++) {
+        const double *a = solid.pos + 3 * (size_t)solid.tri[3 * f], *b = solid.pos + 3 * (size_t)solid.tri[3 * f + 1],
+                     *c = solid.pos + 3 * (size_t)solid.tri[3 * f + 2];
+        double cr[3];
+        fs_cross3(cr, b, c);
+        vol += fs_dot3(a, cr) / 6.0;
+    }
+    for (int32_t t = 0; t < s->mesh.n_tets; t++)
+        want += s->vol[t];
+    CHECK_MSG(fabs(vol - want) < 0.02 * want, "pieces enclose %g cm^3, the layer has %g", vol, want);
+    fs_solid_free(&solid);
+}
+
 /* A strip bonded to a substrate stretched along x breaks across the stretch: the walls of its cracks
  * face along x (their mean orientation, the principal axis of the area-weighted sum of n n^T, within 5
  * degrees: single faces zigzag where the cut snapped to existing nodes). */
@@ -416,6 +475,7 @@ static void test_strip_breaks_across(void)
     printf("strip: %lld splits, crack walls %.2f degrees off the stretch's normal plane on average\n",
            (long long)s->counters.splits, angle);
     CHECK(angle < 5.0);
+    check_solid_closed(s);
     fs_tet_destroy(s);
     fs_mesh_free(&mesh);
 }

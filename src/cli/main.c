@@ -522,7 +522,7 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
     fs_output *mesh_out = NULL, *asset_out = NULL;
     fs_asset_inputs asset = {o->mesh_path, o->asset_path, &res->surface, cfg, name, o->output_dir, out,
                              written->map, written->n, fs_target_name(o->target), maps->height_min_cm,
-                             maps->height_max_cm};
+                             maps->height_max_cm, &res->solid};
     if (rc == 0)
         rc = fs_asset_stage(&asset, &mesh_out, &asset_out);
     const int n = written->n;

@@ -63,3 +63,37 @@ void fs_surface_free(fs_surface *m)
     free(m->tri);
     memset(m, 0, sizeof *m);
 }
+
+int32_t fs_solid_add_position(fs_solid *s, const double p[3])
+{
+    if (s->n_pos == s->cap_pos) {
+        s->cap_pos = grow_capacity(s->cap_pos, s->n_pos + 1);
+        s->pos = fs_realloc(s->pos, 3 * (size_t)s->cap_pos * sizeof *s->pos);
+    }
+    memcpy(s->pos + 3 * (size_t)s->n_pos, p, 3 * sizeof *p);
+    return s->n_pos++;
+}
+
+void fs_solid_add_tri(fs_solid *s, const int32_t v[3], const float uv[6], int wall)
+{
+    if (s->n_tris == s->cap_tris) {
+        s->cap_tris = grow_capacity(s->cap_tris, s->n_tris + 1);
+        s->tri = fs_realloc(s->tri, 3 * (size_t)s->cap_tris * sizeof *s->tri);
+        s->uv = fs_realloc(s->uv, 6 * (size_t)s->cap_tris * sizeof *s->uv);
+        s->wall = fs_realloc(s->wall, (size_t)s->cap_tris);
+    }
+    memcpy(s->tri + 3 * (size_t)s->n_tris, v, 3 * sizeof *v);
+    memcpy(s->uv + 6 * (size_t)s->n_tris, uv, 6 * sizeof *uv);
+    s->wall[s->n_tris++] = (uint8_t)(wall != 0);
+}
+
+void fs_solid_free(fs_solid *s)
+{
+    if (!s)
+        return;
+    free(s->pos);
+    free(s->tri);
+    free(s->uv);
+    free(s->wall);
+    memset(s, 0, sizeof *s);
+}

@@ -243,7 +243,8 @@ int fs_asset_stage(const fs_asset_inputs *in, fs_output **mesh_out, fs_output **
     if (!in->mesh_path && !in->asset_path)
         return 0;
     fs_lifted_mesh lifted;
-    int rc = fs_render_lift(in->surface, &in->cfg->domain, 1.0, &lifted);
+    int rc = in->solid && in->solid->n_tris > 0 ? fs_render_solid(in->solid, &lifted)
+                                                : fs_render_lift(in->surface, &in->cfg->domain, 1.0, &lifted);
     if (rc == 0 && in->mesh_path && !(*mesh_out = stage_mesh(in, &lifted)))
         rc = -1;
     if (rc == 0 && in->asset_path && !(*asset_out = stage_asset(in, &lifted)))

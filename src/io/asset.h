@@ -23,10 +23,12 @@ typedef struct {
     int n_maps;
     const char *target;           /* the --target they were written for */
     double height_min_cm, height_max_cm; /* the height map's range */
+    const fs_solid *solid;        /* the model's closed 3-D pieces (model.h, fs_model_solid), written
+                                     as they are instead of lifting the surface; NULL or empty: lift */
 } fs_asset_inputs;
 
-/* design: the layer is lifted once (render/lift.c, heights at scale 1) and written by
- * io/obj.c and io/gltf.c. Maps are referred to by paths relative to the file that names them (the
+/* design: the layer is lifted once (render/lift.c, heights at scale 1), or taken from the model's
+ * closed pieces when it has them (fs_render_solid), and written by io/obj.c and io/gltf.c. Maps are referred to by paths relative to the file that names them (the
  * MTL, the .gltf): --mesh and --asset may lie outside the output directory.
  *
  * The MTL binds what Wavefront's format and Blender's importer have slots for: the base colour

@@ -76,6 +76,14 @@ int fs_model_surface(const fs_model *m, fs_surface *out)
     }
 }
 
+int fs_model_solid(const fs_model *m, fs_solid *out)
+{
+    switch (m->kind) {
+    case FS_MODEL_TET: return fs_tet_solid(m->state.tet, out) < 0 ? -1 : 1;
+    default: return 0;
+    }
+}
+
 fs_model_info fs_model_stats(const fs_model *m)
 {
     switch (m->kind) {

@@ -22,6 +22,7 @@
  *         fs_model_advance(&m, t_k)                simulate from the current time to t_k
  *         fs_model_surface(&m, &surface)           the texture-space surface of the state now
  *         fs_model_stats(&m)                       fractures and time so far
+ *     fs_model_solid(&m, &solid)                 optional: the 3-D pieces of the final state
  *     fs_model_report(&m); fs_model_free(&m)
  *
  * so a run with frames and one without differ only in where advance stops. Everything a model reads
@@ -39,8 +40,11 @@
  *          fs_model_info fs_NAME_info(const fs_NAME *s);
  *          void fs_NAME_report(const fs_NAME *s);                                       counters, fs_debug
  *          void fs_NAME_destroy(fs_NAME *s);
- *      src/model/NAME/internal.h holds the state struct and what the model's own files (and its
- *      white-box tests) share.
+ *      A model whose fragments are real solids adds the one optional call
+ *          int  fs_NAME_solid(const fs_NAME *s, fs_solid *out);                         0 / -1 + fs_error
+ *      (its closed 3-D pieces, written by --mesh and --asset instead of the lifted surface; a case
+ *      in fs_model_solid). src/model/NAME/internal.h holds the state struct and what the model's
+ *      own files (and its white-box tests) share.
  *   2. Its parameters in fs_model_setup below, its kind in fs_model_kind, a case in each switch of
  *      model.c, its preset section and keys in io/preset.c (offsets into sim's fs_config) and
  *      fissure-preset(5).
@@ -110,6 +114,12 @@ int fs_model_advance(fs_model *m, double t);
 /* The texture-space surface of the current state (geom/surface.h), into out (owned by the caller,
  * empty on entry). Returns 0, or -1 with fs_error. */
 int fs_model_surface(const fs_model *m, fs_surface *out);
+
+/* Optional: the closed 3-D pieces of the current state (geom/surface.h), for models whose fragments
+ * are real solids (tet); --mesh and --asset write them instead of the lifted surface. Fills out
+ * (owned by the caller, empty on entry) and returns 1, or returns 0 leaving it empty for the other
+ * models, or -1 with fs_error. */
+int fs_model_solid(const fs_model *m, fs_solid *out);
 
 /* Fractures and simulated time so far. */
 fs_model_info fs_model_stats(const fs_model *m);

@@ -1205,6 +1205,42 @@ int fs_render_lift(const fs_surface *m, const fs_domain *dom, double height_scal
     return 0;
 }
 
+int fs_render_solid(const fs_solid *s, fs_lifted_mesh *out)
+{
+    memset(out, 0, sizeof *out);
+    for (int64_t k = 0; k < 3 * (int64_t)s->n_pos; k++)
+        if (!isfinite(s->pos[k])) {
+            fs_error(FS_ERR_INTERNAL, "lift: solid position %d is not finite", (int)(k / 3));
+            return -1;
+        }
+    lift_ctx c;
+    memset(&c, 0, sizeof c);
+    c.pos.p = s->pos;
+    c.pos.n = s->n_pos;
+    c.n_t = s->n_tris;
+    c.t = fs_malloc(((size_t)s->n_tris + 1) * sizeof *c.t);
+    dedup_init(&c.uv, 2, 3 * (size_t)s->n_tris);
+    for (int32_t f = 0; f < s->n_tris; f++)
+        for (int k = 0; k < 3; k++) {
+            c.t[f].pos[k] = s->tri[3 * (size_t)f + k];
+            c.t[f].uv[k] = dedup_add(&c.uv, s->uv + 6 * (size_t)f + 2 * k);
+        }
+    out->n_tris = s->n_tris;
+    out->corner = fs_malloc((9 * (size_t)s->n_tris + 1) * sizeof *out->corner);
+    out->wall = fs_malloc((size_t)s->n_tris + 1);
+    memcpy(out->wall, s->wall, (size_t)s->n_tris);
+    build_normals(&c, out);
+    out->n_uv = c.uv.n;
+    out->uv = c.uv.v;
+    out->n_pos = s->n_pos;
+    out->pos = fs_malloc((3 * (size_t)s->n_pos + 1) * sizeof *out->pos);
+    memcpy(out->pos, s->pos, 3 * (size_t)s->n_pos * sizeof *out->pos);
+    imap_free(&c.uv.table);
+    free(c.uv.next);
+    free(c.t);
+    return 0;
+}
+
 void fs_lifted_mesh_free(fs_lifted_mesh *l)
 {
     if (!l)

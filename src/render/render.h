@@ -115,6 +115,12 @@ typedef struct {
 int fs_render_lift(const fs_surface *m, const fs_domain *d, double height_scale, fs_lifted_mesh *out);
 void fs_lifted_mesh_free(fs_lifted_mesh *l);
 
+/* The lifted mesh of a model's closed 3-D pieces (geom/surface.h: fs_solid) in place of
+ * fs_render_lift's: the positions as they are (weld_tolerance 0: pieces keep their own), the texture
+ * coordinates de-duplicated, corner normals as fs_render_lift makes them, the solid's wall flags.
+ * Returns 0, or -1 with fs_error(FS_ERR_INTERNAL) for a non-finite position. */
+int fs_render_solid(const fs_solid *s, fs_lifted_mesh *out);
+
 /* Edges (pairs of position indices) used by exactly one triangle, in the direction their triangle
  * runs along them: 2 * count entries in *edges (caller frees); returns the count. *n_bad (if not
  * NULL) gets the number of edges with more than two triangles or two running the same way: none in

@@ -79,6 +79,8 @@ static int run_model(const fs_config *cfg, const fs_domain *domain, const fs_sim
         fs_surface frame = {0};
         fs_surface *surface = k == count ? &out->surface : &frame;
         rc = fs_model_surface(&model, surface);
+        if (rc == 0 && k == count && fs_model_solid(&model, &out->solid) < 0)
+            rc = -1;
         fs_model_info info = fs_model_stats(&model);
         out->stats.fractures = info.fractures;
         out->stats.simulated_time = info.time;
@@ -150,5 +152,6 @@ void fs_result_free(fs_result *r)
 {
     fs_mesh_free(&r->mesh);
     fs_surface_free(&r->surface);
+    fs_solid_free(&r->solid);
     memset(r, 0, sizeof *r);
 }

@@ -19,6 +19,8 @@ typedef struct {
 typedef struct {
     fs_mesh mesh;            /* the final mesh */
     fs_surface surface;  /* what the renderer draws */
+    fs_solid solid;      /* the final state's closed 3-D pieces, for models that have them (empty
+                            otherwise): what --mesh and --asset write */
     fs_stats stats;
 } fs_result;
 

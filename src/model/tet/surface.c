@@ -124,3 +124,156 @@ int fs_tet_surface(const fs_tet *s, fs_surface *out)
     free(comp);
     return 0;
 }
+
+/* ---- closed pieces ---- */
+
+/* Where a corner of a piece goes: (piece, node, total shift) -> position, in an open-addressing
+ * table (the pieces touch nowhere, so a node two pieces share gets a position in each). */
+typedef struct {
+    int32_t piece, node, sx, sy, pos;
+} piece_corner;
+
+typedef struct {
+    size_t size;
+    piece_corner *slot;
+} corner_table;
+
+static uint64_t corner_hash(int32_t piece, int32_t node, int32_t sx, int32_t sy)
+{
+    uint64_t h = (uint64_t)(uint32_t)node * UINT64_C(0x9e3779b97f4a7c15) ^ (uint64_t)(uint32_t)piece;
+    h = (h ^ (h >> 31)) * UINT64_C(0xbf58476d1ce4e5b9) ^ ((uint64_t)(uint8_t)sx << 8 | (uint8_t)sy);
+    return (h ^ (h >> 29)) * UINT64_C(0x94d049bb133111eb);
+}
+
+static piece_corner *corner_slot(corner_table *tab, int32_t piece, int32_t node, int32_t sx, int32_t sy)
+{
+    size_t k = (size_t)corner_hash(piece, node, sx, sy) & (tab->size - 1);
+    while (tab->slot[k].pos >= 0) {
+        piece_corner *c = &tab->slot[k];
+        if (c->piece == piece && c->node == node && c->sx == sx && c->sy == sy)
+            return c;
+        k = (k + 1) & (tab->size - 1);
+    }
+    return &tab->slot[k];
+}
+
+/* The place in space of a displaced material point of the layer. */
+static void embed(const fs_tet *s, const double p[3], double out[3])
+{
+    const fs_domain *d = &s->mesh.domain;
+    if (d->type == FS_DOMAIN_CYLINDER) {
+        double a = p[0] / d->radius, r = d->radius + p[2];
+        out[0] = r * cos(a);
+        out[1] = r * sin(a);
+        out[2] = p[1];
+        return;
+    }
+    memcpy(out, p, 3 * sizeof *out);
+}
+
+/* Texture coordinates of a material point (unwrapped coordinates on the plane and cylinder). */
+static void texture_point(const fs_tet *s, const double p[3], float uv[2])
+{
+    const fs_domain *d = &s->mesh.domain;
+    if (d->type == FS_DOMAIN_SPHERE) {
+        double q[3], r = fs_norm3(p), t[2];
+        for (int k = 0; k < 3; k++)
+            q[k] = p[k] / r * d->radius;
+        fs_domain_to_uv(d, q, t);
+        uv[0] = (float)t[0];
+        uv[1] = (float)t[1];
+        return;
+    }
+    uv[0] = (float)(p[0] / fs_domain_extent_x(d));
+    uv[1] = (float)(p[1] / fs_domain_extent_y(d));
+}
+
+int fs_tet_solid(const fs_tet *s, fs_solid *out)
+{
+    const fs_tetmesh *m = &s->mesh;
+    int32_t nt = m->n_tets;
+    double c[FS_TET_LOADS];
+    fs_tet_coefficients(s, s->time, c);
+    int32_t *adj = fs_malloc((4 * (size_t)nt + 1) * sizeof *adj);
+    int32_t *comp = fs_malloc(((size_t)nt + 1) * sizeof *comp);
+    fs_tetmesh_adjacency(m, adj);
+    fs_tetmesh_components(m, adj, comp);
+    /* each tetrahedron's shift within its piece: neighbours agree on the corners they share */
+    int32_t *offset = fs_malloc((2 * (size_t)nt + 1) * sizeof *offset);
+    uint8_t *done = fs_calloc((size_t)nt + 1, 1);
+    int32_t *queue = fs_malloc(((size_t)nt + 1) * sizeof *queue);
+    for (int32_t t0 = 0; t0 < nt; t0++) {
+        if (done[t0])
+            continue;
+        int32_t head = 0, tail = 0;
+        queue[tail++] = t0;
+        done[t0] = 1;
+        offset[2 * t0] = offset[2 * t0 + 1] = 0;
+        while (head < tail) {
+            int32_t t = queue[head++];
+            for (int f = 0; f < 4; f++) {
+                int32_t o = adj[4 * (size_t)t + f];
+                if (o < 0 || done[o])
+                    continue;
+                int cv = fs_tet_face[f][0];
+                int32_t v = m->tet[4 * (size_t)t + cv];
+                int co = 0;
+                while (m->tet[4 * (size_t)o + co] != v)
+                    co++;
+                for (int a = 0; a < 2; a++)
+                    offset[2 * o + a] = offset[2 * t + a] + m->shift[8 * (size_t)t + 2 * cv + a] -
+                                        m->shift[8 * (size_t)o + 2 * co + a];
+                done[o] = 1;
+                queue[tail++] = o;
+            }
+        }
+    }
+    free(queue);
+    free(done);
+    size_t corners = 0;
+    for (int32_t h = 0; h < 4 * nt; h++)
+        corners += adj[h] < 0 ? 3 : 0;
+    corner_table tab;
+    tab.size = 64;
+    while (tab.size < 2 * corners)
+        tab.size *= 2;
+    tab.slot = fs_malloc(tab.size * sizeof *tab.slot);
+    for (size_t k = 0; k < tab.size; k++)
+        tab.slot[k].pos = -1;
+    for (int32_t h = 0; h < 4 * nt; h++) {
+        if (adj[h] >= 0)
+            continue;
+        int32_t t = h / 4;
+        const int *fc = fs_tet_face[h % 4];
+        int wall = classify(s, t, h % 4) != FACE_TOP;
+        int32_t v[3];
+        float uv[6];
+        for (int k = 0; k < 3; k++) {
+            int32_t node = m->tet[4 * (size_t)t + fc[k]];
+            int32_t sx = m->shift[8 * (size_t)t + 2 * fc[k]] + offset[2 * t];
+            int32_t sy = m->shift[8 * (size_t)t + 2 * fc[k] + 1] + offset[2 * t + 1];
+            const double *p0 = m->pos + 3 * (size_t)node;
+            double p[3] = {p0[0] + sx * m->period[0], p0[1] + sy * m->period[1], p0[2]};
+            texture_point(s, p, uv + 2 * k);
+            piece_corner *slot = corner_slot(&tab, comp[t], node, sx, sy);
+            if (slot->pos < 0) {
+                double u[3], q[3], w[3];
+                fs_tet_displacement(s, node, c, u);
+                for (int a = 0; a < 3; a++)
+                    q[a] = p[a] + u[a];
+                embed(s, q, w);
+                *slot = (piece_corner){comp[t], node, sx, sy, fs_solid_add_position(out, w)};
+            }
+            v[k] = slot->pos;
+        }
+        if (m->domain.type == FS_DOMAIN_SPHERE)
+            for (int k = 1; k < 3; k++) /* one side of the longitude seam */
+                uv[2 * k] += uv[2 * k] - uv[0] > 0.5f ? -1.0f : (uv[0] - uv[2 * k] > 0.5f ? 1.0f : 0.0f);
+        fs_solid_add_tri(out, v, uv, wall);
+    }
+    free(tab.slot);
+    free(offset);
+    free(adj);
+    free(comp);
+    return 0;
+}

@@ -49,4 +49,11 @@ void fs_tet_destroy(fs_tet *s);
  * Returns 0 or -1. */
 int fs_tet_surface(const fs_tet *s, fs_surface *out);
 
+/* The fragments as closed 3-D pieces (geom/surface.h, fs_solid): every face of the layer that belongs
+ * to one element only, at its displaced position in space (the plane as is, the cylinder's unrolled
+ * layer wrapped around its axis at radius R + height), the top with wall 0 and the crack walls, the
+ * sides and the bottom with wall 1; each fragment with its own positions, unrolled across the seams
+ * (a fragment that wraps all the way round stays cut at the seam). Returns 0 or -1. */
+int fs_tet_solid(const fs_tet *s, fs_solid *out);
+
 #endif
