@@ -7,6 +7,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "base/uf.h"
 #include "base/vec.h"
 
 /* Positions closer than this fraction of the domain's size are one vertex. The render mesh gives
@@ -828,24 +829,6 @@ static int32_t split_columns(lift_ctx *c)
     return splits;
 }
 
-/* Union-find root with path halving. */
-static int32_t uf_find(int32_t *parent, int32_t i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
-static void uf_union(int32_t *parent, int32_t a, int32_t b)
-{
-    a = uf_find(parent, a);
-    b = uf_find(parent, b);
-    if (a != b)
-        parent[a < b ? b : a] = a < b ? a : b;
-}
-
 /* The corner of triangle f at position v (FS_ASSERT: there is one). */
 static int corner_at(const tri *f, int32_t v)
 {
@@ -889,8 +872,7 @@ static int32_t split_nonmanifold(lift_ctx *c)
     edges_build(&et, c->t, c->n_t);
     int32_t n_corner = 3 * c->n_t;
     int32_t *parent = fs_malloc(((size_t)n_corner + 1) * sizeof *parent);
-    for (int32_t i = 0; i < n_corner; i++)
-        parent[i] = i;
+    fs_uf_init(parent, n_corner);
     /* faces of the edges of more than two, as lists */
     int32_t *start = fs_calloc((size_t)et.n + 2, sizeof *start);
     int32_t n_bad = 0;
@@ -921,7 +903,7 @@ static int32_t split_nonmanifold(lift_ctx *c)
         if (er->count == 2) {
             for (int q = 0; q < 2; q++) {
                 int32_t v = q ? er->b : er->a;
-                uf_union(parent, 3 * er->face[0] + corner_at(c->t + er->face[0], v),
+                fs_uf_union(parent, 3 * er->face[0] + corner_at(c->t + er->face[0], v),
                          3 * er->face[1] + corner_at(c->t + er->face[1], v));
             }
             continue;
@@ -974,7 +956,7 @@ static int32_t split_nonmanifold(lift_ctx *c)
             int32_t j = ok ? (fan[i].front_ccw ? (i + m - 1) % m : (i + 1) % m) : 0;
             for (int q = 0; q < 2; q++) {
                 int32_t v = q ? er->b : er->a;
-                uf_union(parent, 3 * fan[i].face + corner_at(c->t + fan[i].face, v),
+                fs_uf_union(parent, 3 * fan[i].face + corner_at(c->t + fan[i].face, v),
                          3 * fan[j].face + corner_at(c->t + fan[j].face, v));
             }
         }
@@ -992,7 +974,7 @@ static int32_t split_nonmanifold(lift_ctx *c)
         owner[i] = -1;
     int32_t added = 0;
     for (int32_t i = 0; i < n_corner; i++) {
-        int32_t v = c->t[i / 3].pos[i % 3], root = uf_find(parent, i);
+        int32_t v = c->t[i / 3].pos[i % 3], root = fs_uf_find(parent, i);
         if (root == i) {
             if (owner[v] < 0) {
                 owner[v] = root;

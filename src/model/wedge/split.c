@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "base/error.h"
+#include "base/uf.h"
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "fracture/rank.h"
@@ -626,15 +627,6 @@ static int32_t cast_ray(cut_state *cs, const fs_wedge_frame *f, int32_t n, const
     return far;
 }
 
-static int32_t find_root(int32_t *parent, int32_t i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
 /* Splits node v into one copy per connected sector of its fan once the edges (v, cut[k]) are cut.
  * Returns the number of sectors (1: v stays whole). */
 static int32_t duplicate_node(cut_state *cs, int32_t v, const int32_t *cut, int32_t n_cut)
@@ -644,8 +636,7 @@ static int32_t duplicate_node(cut_state *cs, int32_t v, const int32_t *cut, int3
     ilist fan = {0};
     tris_at(cs, v, &fan);
     int32_t *parent = fs_malloc(((size_t)fan.n + 1) * sizeof *parent);
-    for (int32_t q = 0; q < fan.n; q++)
-        parent[q] = q;
+    fs_uf_init(parent, fan.n);
     for (int32_t q = 0; q < fan.n; q++) {
         int32_t t = fan.v[q];
         int c = fs_mesh_corner_of(m, t, v);
@@ -661,17 +652,14 @@ static int32_t duplicate_node(cut_state *cs, int32_t v, const int32_t *cut, int3
             if (is_cut)
                 continue;
             for (int32_t r = 0; r < fan.n; r++)
-                if (fan.v[r] == u) {
-                    int32_t x = find_root(parent, q), y = find_root(parent, r);
-                    if (x != y)
-                        parent[x > y ? x : y] = x < y ? x : y;
-                }
+                if (fan.v[r] == u)
+                    fs_uf_union(parent, q, r);
         }
     }
     int32_t sectors = 0;
     int32_t *copy = fs_malloc(((size_t)fan.n + 1) * sizeof *copy);
     for (int32_t q = 0; q < fan.n; q++) {
-        int32_t r = find_root(parent, q);
+        int32_t r = fs_uf_find(parent, q);
         if (r != q) {
             copy[q] = copy[r];
             continue;
