@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/vec.h"
 
@@ -631,13 +632,12 @@ typedef struct {
 
 static void poly_reserve(poly_buf *p, int n)
 {
-    if (n <= p->cap)
-        return;
-    p->cap = 2 * n + 16;
-    p->x = fs_realloc(p->x, (size_t)p->cap * sizeof *p->x);
-    p->y = fs_realloc(p->y, (size_t)p->cap * sizeof *p->y);
-    p->tx = fs_realloc(p->tx, (size_t)p->cap * sizeof *p->tx);
-    p->ty = fs_realloc(p->ty, (size_t)p->cap * sizeof *p->ty);
+    if (FS_ARRAY_GROW(p->cap, n, 64)) {
+        FS_ARRAY_RESIZE(p->x, p->cap);
+        FS_ARRAY_RESIZE(p->y, p->cap);
+        FS_ARRAY_RESIZE(p->tx, p->cap);
+        FS_ARRAY_RESIZE(p->ty, p->cap);
+    }
 }
 
 /* Area of a polygon (relative coordinates, CCW) clipped to the box shifted by -origin. */

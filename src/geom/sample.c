@@ -6,6 +6,7 @@
 #include <stdbool.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/rng.h"
 #include "base/threads.h"
@@ -458,10 +459,7 @@ static double coincident_push(const relax_state *s, int32_t k, int32_t j)
 /* Appends a force on snapshot particle j to a task's log. */
 static void log_force(relax_task *task, int32_t j, const double *v)
 {
-    if (task->n_log == task->cap_log) {
-        task->cap_log = task->cap_log ? 2 * task->cap_log : 1024;
-        task->log = fs_realloc(task->log, (size_t)task->cap_log * sizeof *task->log);
-    }
+    FS_ARRAY_RESERVE(task->log, task->cap_log, task->n_log + 1, 1024);
     force_entry *e = &task->log[task->n_log++];
     e->j = j;
     for (int a = 0; a < 3; a++)

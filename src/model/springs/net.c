@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/vec.h"
 
@@ -664,10 +665,9 @@ static void region_clear(fs_spring_net *net, local_region *g)
 
 static void region_push(fs_spring_net *net, local_region *g, int32_t node, int32_t depth)
 {
-    if (g->n == g->cap) {
-        g->cap = g->cap ? 2 * g->cap : 256;
-        g->nodes = fs_realloc(g->nodes, (size_t)g->cap * sizeof *g->nodes);
-        g->depth = fs_realloc(g->depth, (size_t)g->cap * sizeof *g->depth);
+    if (FS_ARRAY_GROW(g->cap, g->n + 1, 256)) {
+        FS_ARRAY_RESIZE(g->nodes, g->cap);
+        FS_ARRAY_RESIZE(g->depth, g->cap);
     }
     net->local_map[node] = g->n;
     g->nodes[g->n] = node;
@@ -704,10 +704,7 @@ static void region_grow(fs_spring_net *net, local_region *g, const int32_t *seed
             int32_t other = a == i ? b : a;
             if (net->local_map[other] >= 0 && a != i)
                 continue; /* both ends inside: counted from its first end */
-            if (g->ns == g->cap_s) {
-                g->cap_s = g->cap_s ? 2 * g->cap_s : 1024;
-                g->springs = fs_realloc(g->springs, (size_t)g->cap_s * sizeof *g->springs);
-            }
+            FS_ARRAY_RESERVE(g->springs, g->cap_s, g->ns + 1, 1024);
             g->springs[g->ns++] = s;
         }
     }

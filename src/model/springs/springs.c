@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/rng.h"
@@ -472,10 +473,7 @@ static int cascade(fs_springs *s)
         int32_t pick = fs_rank_pick(s->ratio, NULL, s->n_material, s->setup.seed);
         if (pick < 0 || !(s->ratio[pick] > 1.0))
             return 0;
-        if (s->break_count == s->break_capacity) {
-            s->break_capacity = s->break_capacity ? 2 * s->break_capacity : 256;
-            s->breaks = fs_realloc(s->breaks, (size_t)s->break_capacity * sizeof *s->breaks);
-        }
+        FS_ARRAY_RESERVE(s->breaks, s->break_capacity, s->break_count + 1, 256);
         fs_springs_break *b = s->breaks + s->break_count++;
         b->spring = pick;
         b->time = s->time;

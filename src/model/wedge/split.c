@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/uf.h"
 #include "base/vec.h"
@@ -351,11 +352,10 @@ static void tip_add(fs_wedge_model *w, int32_t node, const double dir[3])
 {
     if (tip_find(w, node) >= 0)
         return;
-    if (w->n_tips == w->cap_tips) {
-        w->cap_tips = w->cap_tips ? 2 * w->cap_tips : 16;
-        w->tip_node = fs_realloc(w->tip_node, (size_t)w->cap_tips * sizeof *w->tip_node);
-        w->tip_dir = fs_realloc(w->tip_dir, 3 * (size_t)w->cap_tips * sizeof *w->tip_dir);
-        w->tip_scale = fs_realloc(w->tip_scale, (size_t)w->cap_tips * sizeof *w->tip_scale);
+    if (FS_ARRAY_GROW(w->cap_tips, w->n_tips + 1, 16)) {
+        FS_ARRAY_RESIZE(w->tip_node, w->cap_tips);
+        FS_ARRAY_RESIZE(w->tip_dir, 3 * (size_t)w->cap_tips);
+        FS_ARRAY_RESIZE(w->tip_scale, w->cap_tips);
     }
     w->tip_node[w->n_tips] = node;
     w->tip_scale[w->n_tips] = 1.0;
@@ -372,10 +372,7 @@ typedef struct {
 
 static void ilist_push(ilist *l, int32_t x)
 {
-    if (l->n == l->cap) {
-        l->cap = l->cap ? 2 * l->cap : 16;
-        l->v = fs_realloc(l->v, (size_t)l->cap * sizeof *l->v);
-    }
+    FS_ARRAY_RESERVE(l->v, l->cap, l->n + 1, 16);
     l->v[l->n++] = x;
 }
 

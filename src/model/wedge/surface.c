@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/rng.h"
@@ -403,10 +404,7 @@ static int32_t points_on_edge(const render_ctx *r, const group_grid *g, const do
                 double off, t = edge_param(r, a->rest, b->rest, x.rest, &off);
                 if (!(t > 1e-9 && t < 1.0 - 1e-9) || !(off <= r->tol))
                     continue;
-                if (n == *cap) {
-                    *cap = *cap ? 2 * *cap : 8;
-                    *found = fs_realloc(*found, (size_t)*cap * sizeof **found);
-                }
+                FS_ARRAY_RESERVE(*found, *cap, n + 1, 8);
                 (*found)[n++] = (on_edge){t, grp};
             }
         }
@@ -586,10 +584,9 @@ static int32_t junction_loops(const render_ctx *r, const cross_edge *x, int32_t 
             bool closed = false;
             used[s] = 1;
             for (;;) {
-                if (n_pt + m == cap_pt) {
-                    cap_pt = cap_pt ? 2 * cap_pt : 16;
-                    pt = fs_realloc(pt, (size_t)cap_pt * sizeof *pt);
-                    ed = fs_realloc(ed, (size_t)cap_pt * sizeof *ed);
+                if (FS_ARRAY_GROW(cap_pt, n_pt + m + 1, 16)) {
+                    FS_ARRAY_RESIZE(pt, cap_pt);
+                    FS_ARRAY_RESIZE(ed, cap_pt);
                 }
                 pt[n_pt + m] = x[cur].from;
                 ed[n_pt + m] = cur;
@@ -933,10 +930,7 @@ static int split_render_mesh(render_ctx *r)
                 continue;
             wall_point a = corner_point(r, e, c), b = corner_point(r, e, (c + 1) % 3);
             int32_t k = points_on_edge(r, &grid, gpos, &a, &b, &found, &cap_found);
-            if (n_pts + k + 2 > cap_pts) {
-                cap_pts = 2 * (n_pts + k + 2);
-                pts = fs_realloc(pts, (size_t)cap_pts * sizeof *pts);
-            }
+            FS_ARRAY_RESERVE(pts, cap_pts, n_pts + k + 2, 64);
             wall_first[wl] = n_pts;
             wall_n[wl] = k + 2;
             pts[n_pts++] = a;
