@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "base/error.h"
+#include "base/vec.h"
 
 fs_cg_params fs_cg_params_default(void)
 {
@@ -349,18 +350,17 @@ static int preconditioner(const fs_sparse_matrix *a, const block3_matrix *blocks
     static const double zero[9] = {0};
     for (int32_t ib = 0; ib < blocks->nb; ib++) {
         const double *m = blocks->diag[ib] >= 0 ? blocks->v + 9 * (size_t)blocks->diag[ib] : zero;
-        /* the inverse by cofactors; positive definite iff the leading minors are positive */
-        double c00 = m[4] * m[8] - m[5] * m[7], c01 = m[5] * m[6] - m[3] * m[8], c02 = m[3] * m[7] - m[4] * m[6];
-        double det = m[0] * c00 + m[1] * c01 + m[2] * c02, minor2 = m[0] * m[4] - m[1] * m[3];
-        if (!(m[0] > 0.0 && minor2 > 0.0 && det > 0.0)) {
+        /* the inverse by cofactors; positive definite iff the leading minors (m[0], adj[8], det)
+         * are positive */
+        double adj[9], det = fs_mat3_adjugate(m, adj);
+        if (!(m[0] > 0.0 && adj[8] > 0.0 && det > 0.0)) {
             fs_error(FS_ERR_INTERNAL, "cg: diagonal block of unknowns %d-%d is not positive definite", 3 * ib,
                      3 * ib + 2);
             return -1;
         }
         double *v = inv + 9 * (size_t)ib;
-        v[0] = c00 / det, v[1] = (m[2] * m[7] - m[1] * m[8]) / det, v[2] = (m[1] * m[5] - m[2] * m[4]) / det;
-        v[3] = c01 / det, v[4] = (m[0] * m[8] - m[2] * m[6]) / det, v[5] = (m[2] * m[3] - m[0] * m[5]) / det;
-        v[6] = c02 / det, v[7] = (m[1] * m[6] - m[0] * m[7]) / det, v[8] = minor2 / det;
+        for (int k = 0; k < 9; k++)
+            v[k] = adj[k] / det;
     }
     return 0;
 }

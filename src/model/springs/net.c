@@ -830,19 +830,7 @@ static void invert_block(double *A, int dim)
         A[2] = -A[2] / det;
         return;
     }
-    double c[9];
-    c[0] = A[4] * A[8] - A[5] * A[7];
-    c[1] = A[2] * A[7] - A[1] * A[8];
-    c[2] = A[1] * A[5] - A[2] * A[4];
-    c[3] = A[5] * A[6] - A[3] * A[8];
-    c[4] = A[0] * A[8] - A[2] * A[6];
-    c[5] = A[2] * A[3] - A[0] * A[5];
-    c[6] = A[3] * A[7] - A[4] * A[6];
-    c[7] = A[1] * A[6] - A[0] * A[7];
-    c[8] = A[0] * A[4] - A[1] * A[3];
-    double det = A[0] * c[0] + A[1] * c[3] + A[2] * c[6];
-    for (int m = 0; m < 9; m++)
-        A[m] = c[m] / det;
+    fs_mat3_inverse(A, A);
 }
 
 /* y = K_RR v over the region (nodes outside held: their v is 0); D holds the diagonal blocks (springs,
