@@ -13,6 +13,7 @@
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "fracture/rank.h"
+#include "fracture/separation.h"
 #include "geom/refine.h"
 #include "model/wedge/element.h"
 #include "solve/cg.h"
@@ -1173,8 +1174,7 @@ int fs_wedge_nodal_stress(const fs_wedge_model *w, int32_t node, bool top, doubl
 {
     /* The Gauss point nearest corner c: (2/3, 1/6) for node 0 (r = 1), (1/6, 2/3) for node 1 (s = 1),
      * (1/6, 1/6) for node 2; the top row of Table 5.1 for top nodes, the bottom row otherwise. */
-    memset(stress, 0, 6 * sizeof *stress);
-    int count = 0;
+    fs_nodal_stress mean = {{0.0}, 0};
     for (int32_t p = w->node_elem_start[node]; p < w->node_elem_start[node] + w->node_elem_count[node]; p++) {
         int32_t e = w->node_elem[p];
         if (w->state[e] != FS_WEDGE_ALIVE)
@@ -1187,13 +1187,10 @@ int fs_wedge_nodal_stress(const fs_wedge_model *w, int32_t node, bool top, doubl
         double s[6];
         if (fs_wedge_element_stress(w, e, g[0], g[1], g[2], s) < 0)
             return -1;
-        for (int k = 0; k < 6; k++)
-            stress[k] += s[k];
-        count++;
+        fs_nodal_stress_add(&mean, s);
     }
-    for (int k = 0; k < 6 && count; k++)
-        stress[k] /= count;
-    return count;
+    fs_nodal_stress_mean(&mean, stress);
+    return mean.count;
 }
 
 /* ---- construction ---- */
