@@ -1,6 +1,8 @@
 /* Networks of point masses and springs relaxed to equilibrium: global inexact Newton on CHOLMOD, local conjugate gradients. */
 #include "model/springs/internal.h"
 
+#include "config.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -364,6 +366,11 @@ static void net_assemble(fs_spring_net *net)
         eps = 1e-300;
     for (int32_t j = 0; j < net->K.n; j++)
         net->K.values[net->K.col_ptr[j + 1] - 1] += eps;
+#ifdef FS_VALIDATE
+    char why[256];
+    FS_INVARIANT(fs_sparse_matrix_check(&net->K, why, sizeof why), "springs network, after assembling the tangent: %s",
+                 why);
+#endif
 }
 
 /* Assembles and factorizes at the current state, remembering it for downdates. */

@@ -508,6 +508,18 @@ void fs_wedge_prescribe_fixed(fs_wedge_model *w);
  * with fs_error. */
 int fs_wedge_update_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n);
 
+/* ---- --enable-validate (base/error.h: FS_INVARIANT) ---- */
+
+/* Each aborts, naming the broken invariant and `after` (the step just done), unless it holds:
+ * the mesh: fs_mesh_check (manifold, consistently oriented, valid adjacency) and as many elements as
+ * triangles; the system: K_ff a consistent upper triangle with finite values (fs_sparse_matrix_check),
+ * of order n_free; the state: finite displacements of every node and finite top stresses of every
+ * living element. Called from #ifdef FS_VALIDATE blocks after every mesh change, assembly and
+ * equilibrium. */
+void fs_wedge_check_mesh(const fs_wedge_model *w, const char *after);
+void fs_wedge_check_system(const fs_wedge_model *w, const char *after);
+void fs_wedge_check_state(const fs_wedge_model *w, const char *after);
+
 /* Fragment label of every element (-1 for removed ones, else 0 .. count-1 numbered by their smallest
  * element); returns the count. labels has n_elems entries. */
 int32_t fs_wedge_fragments(const fs_wedge_model *w, int32_t *labels);

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "config.h"
 #include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
@@ -458,6 +459,10 @@ static int relax_region(fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds
     free(x_before);
     free(map);
     free(region);
+#ifdef FS_VALIDATE
+    if (rc == 0)
+        fs_wedge_check_state(w, "a local relaxation");
+#endif
     return rc;
 }
 

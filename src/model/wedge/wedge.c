@@ -1,6 +1,8 @@
 /* The wedge model's layer: geometry and materials from the mesh, sparse assembly, equilibrium (CHOLMOD or CG) and element stresses. */
 #include "model/wedge/internal.h"
 
+#include "config.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -566,6 +568,9 @@ static void fix_orphans(fs_wedge_model *w)
 
 static int factorize(fs_wedge_model *w, bool analyze)
 {
+#ifdef FS_VALIDATE
+    fs_wedge_check_system(w, "assembly");
+#endif
     if (w->cfg.solver.method != FS_SOLVER_CHOLMOD || w->n_free == 0)
         return 0;
     double t0 = fs_seconds();
@@ -1078,7 +1083,12 @@ int fs_wedge_equilibrium(fs_wedge_model *w, double t)
         return -1;
     scatter_u(w);
     w->time = t;
-    return element_ratios(w, NULL, w->n_elems);
+    int rc = element_ratios(w, NULL, w->n_elems);
+#ifdef FS_VALIDATE
+    if (rc == 0)
+        fs_wedge_check_state(w, "an equilibrium");
+#endif
+    return rc;
 }
 
 void fs_wedge_snapshot_take(const fs_wedge_model *w, fs_wedge_snapshot *s)
@@ -1719,6 +1729,10 @@ vectors:;
  * none (the factor is dropped and the global solves use CG until fs_wedge_refactor, see solve()). */
 static int pattern_changed(fs_wedge_model *w)
 {
+#ifdef FS_VALIDATE
+    fs_wedge_check_mesh(w, "a change of the mesh");
+    fs_wedge_check_system(w, "a change of the mesh");
+#endif
     if (w->cfg.solver.relax == FS_RELAX_LOCAL && w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
         fs_cholesky_free(w->chol);
         w->chol = NULL;
@@ -1964,3 +1978,34 @@ double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e)
 }
 
 fs_wedge_params fs_wedge_params_default(void) { return (fs_wedge_params){.thickness_gradient = 0.0}; }
+
+void fs_wedge_check_mesh(const fs_wedge_model *w, const char *after)
+{
+    char why[256];
+    FS_INVARIANT(fs_mesh_check(w->mesh, why, sizeof why), "wedge model, after %s: the mesh: %s", after, why);
+    FS_INVARIANT(w->mesh->n_tris == w->n_elems && w->mesh->n_nodes == w->n_nodes,
+                 "wedge model, after %s: %d elements and %d nodes for a mesh of %d triangles and %d nodes", after,
+                 (int)w->n_elems, (int)w->n_nodes, (int)w->mesh->n_tris, (int)w->mesh->n_nodes);
+}
+
+void fs_wedge_check_system(const fs_wedge_model *w, const char *after)
+{
+    char why[256];
+    FS_INVARIANT(w->k_free.n == w->n_free, "wedge model, after %s: K_ff of order %d for %d free unknowns", after,
+                 (int)w->k_free.n, (int)w->n_free);
+    FS_INVARIANT(fs_sparse_matrix_check(&w->k_free, why, sizeof why), "wedge model, after %s: K_ff: %s", after, why);
+}
+
+void fs_wedge_check_state(const fs_wedge_model *w, const char *after)
+{
+    int64_t bad = fs_first_nonfinite(w->u, 6 * (size_t)w->n_nodes);
+    FS_INVARIANT(bad < 0, "wedge model, after %s at time %g: displacement %d of node %d is %g", after, w->time,
+                 (int)(bad % 6), (int)(bad / 6), w->u[bad]);
+    for (int32_t e = 0; e < w->n_elems; e++) {
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        bad = fs_first_nonfinite(w->stress_top + 18 * (size_t)e, 18);
+        FS_INVARIANT(bad < 0, "wedge model, after %s at time %g: stress component %d of element %d is %g", after,
+                     w->time, (int)bad, (int)e, w->stress_top[18 * (size_t)e + bad]);
+    }
+}
