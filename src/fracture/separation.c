@@ -20,14 +20,20 @@ bool fs_nodal_stress_mean(const fs_nodal_stress *a, double mean[6])
     return a->count > 0;
 }
 
+/* The largest of a decomposition's values (descending) and its vector: *value and normal (if not
+ * NULL); passes rc on. */
+static int largest_of(int rc, const double values[3], const double vectors[9], double *value, double normal[3])
+{
+    *value = values[0];
+    if (normal)
+        memcpy(normal, vectors, 3 * sizeof *normal);
+    return rc;
+}
+
 int fs_nodal_principal_plane(const double stress[6], double *sigma1, double normal[3])
 {
     double sigma[3], dirs[9];
-    int rc = fs_eigen_principal_stress(stress, sigma, normal ? dirs : NULL);
-    *sigma1 = sigma[0];
-    if (normal)
-        memcpy(normal, dirs, 3 * sizeof *normal);
-    return rc;
+    return largest_of(fs_eigen_principal_stress(stress, sigma, normal ? dirs : NULL), sigma, dirs, sigma1, normal);
 }
 
 int fs_separation_split_stress(const double stress[6], double plus[6], double minus[6])
@@ -88,9 +94,5 @@ void fs_separation_tensor(const double *f_plus, int32_t n_plus, const double *f_
 int fs_separation_largest(const double zeta[9], double *value, double normal[3])
 {
     double v[3], n[9];
-    int rc = fs_eigen_sym3(zeta, v, normal ? n : NULL);
-    *value = v[0];
-    if (normal)
-        memcpy(normal, n, 3 * sizeof *normal);
-    return rc;
+    return largest_of(fs_eigen_sym3(zeta, v, normal ? n : NULL), v, n, value, normal);
 }
