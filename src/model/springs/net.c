@@ -217,6 +217,24 @@ static void spring_block(int dim, double k, double rest, const double *d, double
             H[p * dim + q] = k * ((1.0 - c) * nv[p] * nv[q] + (p == q ? c : 0.0));
 }
 
+/* Anchor a (its stiffness k not 0) at positions x: d = its node's position minus its point, *r2 = |d|^2;
+ * returns the factor g of its force -g d on the node: k, or k slide / |d| beyond the slide length
+ * (where the anchor pulls with a constant force). */
+static double anchor_pull(const fs_spring_net *net, int32_t a, const double *x, double d[3], double *r2)
+{
+    int dim = net->dim;
+    double k = net->anchor_k[a];
+    const double *xi = x + (size_t)dim * (size_t)net->anchor_node[a], *at = net->anchor_at + (size_t)dim * (size_t)a;
+    double s = 0.0;
+    for (int q = 0; q < dim; q++) {
+        d[q] = xi[q] - at[q];
+        s += d[q] * d[q];
+    }
+    *r2 = s;
+    double r = sqrt(s);
+    return net->slide > 0.0 && r > net->slide ? k * net->slide / r : k;
+}
+
 /* Energy and, when f is not NULL, the forces on the free unknowns, at positions x. Returns the
  * energy; *fmax (if not NULL) receives the largest node force norm. */
 static double net_eval(const fs_spring_net *net, const double *x, double *f, double *fmax)
@@ -251,19 +269,11 @@ static double net_eval(const fs_spring_net *net, const double *x, double *f, dou
         if (k == 0.0)
             continue;
         int32_t i = net->anchor_node[a];
-        const double *xi = x + (size_t)dim * (size_t)i, *at = net->anchor_at + (size_t)dim * (size_t)a;
-        double d[3], r2 = 0.0;
-        for (int q = 0; q < dim; q++) {
-            d[q] = xi[q] - at[q];
-            r2 += d[q] * d[q];
-        }
-        double r = sqrt(r2), g = k;
-        if (slide > 0.0 && r > slide) {
+        double d[3], r2, g = anchor_pull(net, a, x, d, &r2), r = sqrt(r2);
+        if (slide > 0.0 && r > slide)
             energy += k * slide * (r - slide) + 0.5 * k * slide * slide;
-            g = k * slide / r;
-        } else {
+        else
             energy += 0.5 * k * r2;
-        }
         int32_t di = net->dof[i];
         if (f && di >= 0)
             for (int q = 0; q < dim; q++)
@@ -623,18 +633,9 @@ static void node_force(const fs_spring_net *net, int32_t i, const double *x, dou
     }
     for (int32_t p = net->anc_start[i]; p < net->anc_start[i + 1]; p++) {
         int32_t a = net->anc_list[p];
-        double k = net->anchor_k[a];
-        if (k == 0.0)
+        if (net->anchor_k[a] == 0.0)
             continue;
-        const double *xi = x + (size_t)dim * (size_t)i, *at = net->anchor_at + (size_t)dim * (size_t)a;
-        double d[3], r2 = 0.0;
-        for (int q = 0; q < dim; q++) {
-            d[q] = xi[q] - at[q];
-            r2 += d[q] * d[q];
-        }
-        double r = sqrt(r2), g = k;
-        if (net->slide > 0.0 && r > net->slide)
-            g = k * net->slide / r;
+        double d[3], r2, g = anchor_pull(net, a, x, d, &r2);
         for (int q = 0; q < dim; q++)
             out[q] -= g * d[q];
     }
