@@ -10,6 +10,7 @@
 #include "base/array.h"
 #include "base/error.h"
 #include "base/vec.h"
+#include "geom/region.h"
 #include "solve/cg.h"
 
 /* ==== the generic network ==== */
@@ -62,6 +63,7 @@ void fs_spring_net_free(fs_spring_net *net)
     free(net->anc_start);
     free(net->anc_list);
     free(net->local_map);
+    free(net->local_dist);
     free(net->seeds);
     memset(net, 0, sizeof *net);
 }
@@ -158,10 +160,14 @@ int fs_spring_net_prepare(fs_spring_net *net)
     net->anc_start = fs_calloc((size_t)n + 2, sizeof *net->anc_start);
     net->anc_list = fs_malloc(((size_t)net->n_anchors + 1) * sizeof *net->anc_list);
     net->local_map = fs_malloc(((size_t)n + 1) * sizeof *net->local_map);
+    free(net->local_dist);
+    net->local_dist = fs_malloc(((size_t)n + 1) * sizeof *net->local_dist);
     free(net->seeds);
     net->seeds = fs_malloc(((size_t)n + 1) * sizeof *net->seeds);
-    for (int32_t i = 0; i < n; i++)
+    for (int32_t i = 0; i < n; i++) {
         net->local_map[i] = -1;
+        net->local_dist[i] = INFINITY;
+    }
     for (int32_t s = 0; s < net->n_springs; s++) {
         net->adj_start[net->node[2 * s] + 1]++;
         net->adj_start[net->node[2 * s + 1] + 1]++;
@@ -651,9 +657,8 @@ static double norm_dim(const double *v, int dim)
 
 /* The region of a local relaxation and its scratch. */
 typedef struct {
-    int32_t n, cap;          /* region nodes */
-    int32_t *nodes;
-    int32_t *depth;
+    int32_t n;               /* region nodes */
+    int32_t *nodes;          /* n_nodes entries */
     int32_t ns, cap_s;       /* springs with an end in the region (each once), intact */
     int32_t *springs;
     double *H;               /* dim * dim per region spring */
@@ -669,37 +674,38 @@ static void region_clear(fs_spring_net *net, local_region *g)
     g->ns = 0;
 }
 
-static void region_push(fs_spring_net *net, local_region *g, int32_t node, int32_t depth)
+/* fs_region_edges_fn of a spring network: the intact springs of node i to free nodes, one hop each,
+ * in the order of its adjacency. */
+static void intact_springs(void *ctx, int32_t i, fs_region *r)
 {
-    if (FS_ARRAY_GROW(g->cap, g->n + 1, 256)) {
-        FS_ARRAY_RESIZE(g->nodes, g->cap);
-        FS_ARRAY_RESIZE(g->depth, g->cap);
+    const fs_spring_net *net = ctx;
+    for (int32_t p = net->adj_start[i]; p < net->adj_start[i + 1]; p++) {
+        int32_t s = net->adj_spring[p];
+        if (net->k[s] == 0.0)
+            continue;
+        int32_t j = net->node[2 * s] == i ? net->node[2 * s + 1] : net->node[2 * s];
+        if (net->dof[j] >= 0)
+            fs_region_reach(r, j, 1.0);
     }
-    net->local_map[node] = g->n;
-    g->nodes[g->n] = node;
-    g->depth[g->n++] = depth;
 }
 
-/* Breadth-first over intact springs from the seeds to the given depth, free nodes only. */
+/* Breadth-first over intact springs from the seeds to the given depth, free nodes only (geom/region.h
+ * with one hop per spring, ties by arrival: the nodes in the order of a breadth-first queue). */
 static void region_grow(fs_spring_net *net, local_region *g, const int32_t *seeds, int32_t n_seeds, int32_t radius)
 {
     region_clear(net, g);
+    int32_t *free_seeds = fs_malloc(((size_t)n_seeds + 1) * sizeof *free_seeds), n_free = 0;
     for (int32_t k = 0; k < n_seeds; k++)
-        if (net->dof[seeds[k]] >= 0 && net->local_map[seeds[k]] < 0)
-            region_push(net, g, seeds[k], 0);
-    for (int32_t head = 0; head < g->n; head++) {
-        int32_t i = g->nodes[head], dep = g->depth[head];
-        if (dep >= radius)
-            continue;
-        for (int32_t p = net->adj_start[i]; p < net->adj_start[i + 1]; p++) {
-            int32_t s = net->adj_spring[p];
-            if (net->k[s] == 0.0)
-                continue;
-            int32_t j = net->node[2 * s] == i ? net->node[2 * s + 1] : net->node[2 * s];
-            if (net->local_map[j] < 0 && net->dof[j] >= 0)
-                region_push(net, g, j, dep + 1);
-        }
-    }
+        if (net->dof[seeds[k]] >= 0)
+            free_seeds[n_free++] = seeds[k];
+    if (!g->nodes)
+        g->nodes = fs_malloc(((size_t)net->n_nodes + 1) * sizeof *g->nodes);
+    g->n = fs_region_grow(free_seeds, n_free, radius, FS_REGION_TIES_BY_ARRIVAL, intact_springs, net, net->local_dist,
+                          g->nodes);
+    fs_region_forget(net->local_dist, g->nodes, g->n);
+    for (int32_t k = 0; k < g->n; k++)
+        net->local_map[g->nodes[k]] = k;
+    free(free_seeds);
     for (int32_t k = 0; k < g->n; k++) {
         int32_t i = g->nodes[k];
         for (int32_t p = net->adj_start[i]; p < net->adj_start[i + 1]; p++) {
@@ -727,7 +733,6 @@ static void region_free(fs_spring_net *net, local_region *g)
 {
     region_clear(net, g);
     free(g->nodes);
-    free(g->depth);
     free(g->springs);
     free(g->H);
     free(g->P);
