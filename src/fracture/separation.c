@@ -1,4 +1,4 @@
-/* The separation tensor (O'Brien & Hodgins 1999, §4.1-4.2). */
+/* Nodal principal planes and the separation tensor. */
 #include "fracture/separation.h"
 
 #include <math.h>
@@ -6,110 +6,93 @@
 
 #include "fracture/eigen.h"
 
-static void voigt_to_matrix(const double s[6], double a[9])
+void fs_nodal_stress_add(fs_nodal_stress *a, const double s[6])
 {
-    a[0] = s[0];
-    a[4] = s[1];
-    a[8] = s[2];
-    a[1] = a[3] = s[3];
-    a[5] = a[7] = s[4];
-    a[2] = a[6] = s[5];
+    for (int k = 0; k < 6; k++)
+        a->sum[k] += s[k];
+    a->count++;
 }
 
-int fs_separation_split(const double stress[6], double plus[6], double minus[6])
+bool fs_nodal_stress_mean(const fs_nodal_stress *a, double mean[6])
 {
-    /* all eigenvalues <= 0, or all >= 0: no decomposition needed */
-    if (fs_eigen_principal_bound(stress, 0.0) <= 0.0) {
-        memset(plus, 0, 6 * sizeof *plus);
-        memcpy(minus, stress, 6 * sizeof *minus);
-        return 0;
-    }
-    const double neg[6] = {-stress[0], -stress[1], -stress[2], -stress[3], -stress[4], -stress[5]};
-    if (fs_eigen_principal_bound(neg, 0.0) <= 0.0) {
-        memcpy(plus, stress, 6 * sizeof *plus);
-        memset(minus, 0, 6 * sizeof *minus);
-        return 0;
-    }
-    double a[9], v[3], n[9];
-    voigt_to_matrix(stress, a);
-    if (fs_eigen_sym3(a, v, n) < 0) {
-        memset(plus, 0, 6 * sizeof *plus);
-        memset(minus, 0, 6 * sizeof *minus);
-        return -1;
-    }
-    memset(plus, 0, 6 * sizeof *plus);
-    memset(minus, 0, 6 * sizeof *minus);
-    for (int i = 0; i < 3; i++) {
+    for (int k = 0; k < 6; k++)
+        mean[k] = a->count > 0 ? a->sum[k] / a->count : 0.0;
+    return a->count > 0;
+}
+
+/* The largest of a decomposition's values (descending) and its vector: *value and normal (if not
+ * NULL); passes rc on. */
+static int largest_of(int rc, const double values[3], const double vectors[9], double *value, double normal[3])
+{
+    *value = values[0];
+    if (normal)
+        memcpy(normal, vectors, 3 * sizeof *normal);
+    return rc;
+}
+
+int fs_nodal_principal_plane(const double stress[6], double *sigma1, double normal[3])
+{
+    double sigma[3], dirs[9];
+    return largest_of(fs_eigen_principal_stress(stress, sigma, normal ? dirs : NULL), sigma, dirs, sigma1, normal);
+}
+
+int fs_separation_split_stress(const double stress[6], double plus[6], double minus[6])
+{
+    double v[3], n[9];
+    int rc = fs_eigen_principal_stress(stress, v, n);
+    double p[6] = {0.0}, q[6] = {0.0};
+    for (int i = 0; i < 3 && rc == 0; i++) {
         const double *e = n + 3 * i;
-        double outer[6] = {e[0] * e[0], e[1] * e[1], e[2] * e[2], e[0] * e[1], e[1] * e[2], e[2] * e[0]};
-        double *dst = v[i] > 0.0 ? plus : minus;
+        /* v_i e e^T in Voigt order xx, yy, zz, xy, yz, zx */
+        const double outer[6] = {e[0] * e[0], e[1] * e[1], e[2] * e[2], e[0] * e[1], e[1] * e[2], e[2] * e[0]};
+        double *to = v[i] > 0.0 ? p : q;
         for (int k = 0; k < 6; k++)
-            dst[k] += v[i] * outer[k];
+            to[k] += v[i] * outer[k];
     }
-    return 0;
+    if (plus)
+        memcpy(plus, p, sizeof p);
+    if (minus)
+        memcpy(minus, q, sizeof q);
+    return rc;
 }
 
-void fs_separation_m(const double a[3], double m[6])
+void fs_separation_add_m(double zeta[9], const double a[3], double scale)
 {
     double len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-    if (!(len > 0.0)) {
-        memset(m, 0, 6 * sizeof *m);
+    if (!(len > 0.0))
         return;
+    double k = scale / len;
+    for (int i = 0; i < 3; i++)
+        for (int j = i; j < 3; j++) {
+            double v = k * a[i] * a[j]; /* once for both triangles: a symmetric zeta stays symmetric */
+            zeta[3 * i + j] += v;
+            if (j != i)
+                zeta[3 * j + i] += v;
+        }
+}
+
+/* zeta += sign (sum m(f) - m(F)) over n forces f (F their sum): one half of Eq. 32. */
+static void add_balanced(double zeta[9], const double *f, int32_t n, double sign)
+{
+    double total[3] = {0.0, 0.0, 0.0};
+    for (int32_t q = 0; q < n; q++) {
+        fs_separation_add_m(zeta, f + 3 * (size_t)q, 0.5 * sign);
+        for (int k = 0; k < 3; k++)
+            total[k] += f[3 * (size_t)q + k];
     }
-    m[0] = a[0] * a[0] / len;
-    m[1] = a[1] * a[1] / len;
-    m[2] = a[2] * a[2] / len;
-    m[3] = a[0] * a[1] / len;
-    m[4] = a[1] * a[2] / len;
-    m[5] = a[2] * a[0] / len;
+    fs_separation_add_m(zeta, total, -0.5 * sign);
 }
 
-void fs_separation_init(fs_separation *s)
+void fs_separation_tensor(const double *f_plus, int32_t n_plus, const double *f_minus, int32_t n_minus,
+                          double zeta[9])
 {
-    memset(s, 0, sizeof *s);
+    memset(zeta, 0, 9 * sizeof *zeta);
+    add_balanced(zeta, f_plus, n_plus, 1.0);
+    add_balanced(zeta, f_minus, n_minus, -1.0);
 }
 
-void fs_separation_add(fs_separation *s, const double f_plus[3], const double f_minus[3])
+int fs_separation_largest(const double zeta[9], double *value, double normal[3])
 {
-    double mp[6], mm[6];
-    fs_separation_m(f_plus, mp);
-    fs_separation_m(f_minus, mm);
-    for (int k = 0; k < 3; k++) {
-        s->f_plus[k] += f_plus[k];
-        s->f_minus[k] += f_minus[k];
-    }
-    for (int k = 0; k < 6; k++) {
-        s->m_plus[k] += mp[k];
-        s->m_minus[k] += mm[k];
-    }
-}
-
-void fs_separation_tensor(const fs_separation *s, double zeta[6])
-{
-    double up[6], um[6];
-    fs_separation_m(s->f_plus, up);
-    fs_separation_m(s->f_minus, um);
-    for (int k = 0; k < 6; k++)
-        zeta[k] = 0.5 * (-up[k] + s->m_plus[k] + um[k] - s->m_minus[k]);
-}
-
-int fs_separation_eigen(const double zeta[6], double values[3], double vectors[9])
-{
-    double a[9];
-    voigt_to_matrix(zeta, a);
-    return fs_eigen_sym3(a, values, vectors);
-}
-
-int fs_separation_largest(const double zeta[6], double *value, double normal[3])
-{
-    double a[9], v[3], n[9];
-    voigt_to_matrix(zeta, a);
-    if (fs_eigen_sym3(a, v, n) < 0) {
-        *value = 0.0;
-        normal[0] = normal[1] = normal[2] = 0.0;
-        return -1;
-    }
-    *value = v[0];
-    memcpy(normal, n, 3 * sizeof *normal);
-    return 0;
+    double v[3], n[9];
+    return largest_of(fs_eigen_sym3(zeta, v, normal ? n : NULL), v, n, value, normal);
 }

@@ -39,7 +39,8 @@ typedef struct {
     int32_t *tri;    /* 3 positions per triangle */
     float *uv;       /* 6 per triangle: (u, v) of each corner */
     uint8_t *wall;   /* per triangle: 0 on the layer's top, 1 elsewhere (crack walls, sides, bottom) */
-    int32_t cap_pos, cap_tris;
+    int32_t cap_pos;  /* doubles allocated in pos */
+    int32_t cap_tris; /* triangles allocated */
 } fs_solid;
 
 /* Appends a position (returns its index) or a triangle (uv: its corners' 6 values). */

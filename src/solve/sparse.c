@@ -1,6 +1,7 @@
 /* Sparse symmetric assembly and products, and the only CHOLMOD user: sparse Cholesky for the equilibrium solves. */
 #include "solve/sparse.h"
 
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
@@ -8,6 +9,7 @@
 #include <cholmod.h>
 #include <dlfcn.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/threads.h"
@@ -37,15 +39,11 @@ void fs_sparse_builder_clear(fs_sparse_builder *b) { b->count = 0; }
 
 static void builder_reserve(fs_sparse_builder *b, size_t extra)
 {
-    if (b->count + extra <= b->capacity)
-        return;
-    size_t capacity = b->capacity ? b->capacity : 64;
-    while (capacity < b->count + extra)
-        capacity *= 2;
-    b->rows = fs_realloc(b->rows, capacity * sizeof *b->rows);
-    b->cols = fs_realloc(b->cols, capacity * sizeof *b->cols);
-    b->values = fs_realloc(b->values, capacity * sizeof *b->values);
-    b->capacity = capacity;
+    if (FS_ARRAY_GROW(b->capacity, b->count + extra, 64)) {
+        FS_ARRAY_RESIZE(b->rows, b->capacity);
+        FS_ARRAY_RESIZE(b->cols, b->capacity);
+        FS_ARRAY_RESIZE(b->values, b->capacity);
+    }
 }
 
 size_t fs_sparse_builder_add(fs_sparse_builder *b, int32_t row, int32_t col, double value)
@@ -168,6 +166,43 @@ void fs_sparse_matrix_free(fs_sparse_matrix *m)
     free(m->row_idx);
     free(m->values);
     memset(m, 0, sizeof *m);
+}
+
+bool fs_sparse_matrix_check(const fs_sparse_matrix *m, char *why, size_t len)
+{
+    char dummy[8];
+    if (!why) {
+        why = dummy;
+        len = sizeof dummy;
+    }
+    if (m->n < 0 || (m->n > 0 && (!m->col_ptr || m->col_ptr[0] != 0))) {
+        snprintf(why, len, "order %d, or col_ptr does not start at 0", (int)m->n);
+        return false;
+    }
+    for (int32_t j = 0; j < m->n; j++) {
+        int32_t p0 = m->col_ptr[j], p1 = m->col_ptr[j + 1];
+        if (p1 <= p0) {
+            snprintf(why, len, "column %d is empty (col_ptr %d, %d): no diagonal entry", (int)j, (int)p0, (int)p1);
+            return false;
+        }
+        for (int32_t p = p0; p < p1; p++) {
+            int32_t i = m->row_idx[p];
+            if (i < 0 || i > j || (p > p0 && i <= m->row_idx[p - 1])) {
+                snprintf(why, len, "column %d: row %d at entry %d is below the diagonal, out of range or out of order",
+                         (int)j, (int)i, (int)p);
+                return false;
+            }
+            if (!isfinite(m->values[p])) {
+                snprintf(why, len, "entry (%d, %d) is %g", (int)i, (int)j, m->values[p]);
+                return false;
+            }
+        }
+        if (m->row_idx[p1 - 1] != j) {
+            snprintf(why, len, "column %d does not end with its diagonal entry", (int)j);
+            return false;
+        }
+    }
+    return true;
 }
 
 void fs_sparse_matrix_zero(fs_sparse_matrix *m)

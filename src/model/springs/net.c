@@ -1,12 +1,17 @@
 /* Networks of point masses and springs relaxed to equilibrium: global inexact Newton on CHOLMOD, local conjugate gradients. */
 #include "model/springs/internal.h"
 
+#include "config.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/vec.h"
+#include "geom/region.h"
+#include "solve/cg.h"
 
 /* ==== the generic network ==== */
 
@@ -58,6 +63,7 @@ void fs_spring_net_free(fs_spring_net *net)
     free(net->anc_start);
     free(net->anc_list);
     free(net->local_map);
+    free(net->local_dist);
     free(net->seeds);
     memset(net, 0, sizeof *net);
 }
@@ -154,10 +160,14 @@ int fs_spring_net_prepare(fs_spring_net *net)
     net->anc_start = fs_calloc((size_t)n + 2, sizeof *net->anc_start);
     net->anc_list = fs_malloc(((size_t)net->n_anchors + 1) * sizeof *net->anc_list);
     net->local_map = fs_malloc(((size_t)n + 1) * sizeof *net->local_map);
+    free(net->local_dist);
+    net->local_dist = fs_malloc(((size_t)n + 1) * sizeof *net->local_dist);
     free(net->seeds);
     net->seeds = fs_malloc(((size_t)n + 1) * sizeof *net->seeds);
-    for (int32_t i = 0; i < n; i++)
+    for (int32_t i = 0; i < n; i++) {
         net->local_map[i] = -1;
+        net->local_dist[i] = INFINITY;
+    }
     for (int32_t s = 0; s < net->n_springs; s++) {
         net->adj_start[net->node[2 * s] + 1]++;
         net->adj_start[net->node[2 * s + 1] + 1]++;
@@ -213,6 +223,24 @@ static void spring_block(int dim, double k, double rest, const double *d, double
             H[p * dim + q] = k * ((1.0 - c) * nv[p] * nv[q] + (p == q ? c : 0.0));
 }
 
+/* Anchor a (its stiffness k not 0) at positions x: d = its node's position minus its point, *r2 = |d|^2;
+ * returns the factor g of its force -g d on the node: k, or k slide / |d| beyond the slide length
+ * (where the anchor pulls with a constant force). */
+static double anchor_pull(const fs_spring_net *net, int32_t a, const double *x, double d[3], double *r2)
+{
+    int dim = net->dim;
+    double k = net->anchor_k[a];
+    const double *xi = x + (size_t)dim * (size_t)net->anchor_node[a], *at = net->anchor_at + (size_t)dim * (size_t)a;
+    double s = 0.0;
+    for (int q = 0; q < dim; q++) {
+        d[q] = xi[q] - at[q];
+        s += d[q] * d[q];
+    }
+    *r2 = s;
+    double r = sqrt(s);
+    return net->slide > 0.0 && r > net->slide ? k * net->slide / r : k;
+}
+
 /* Energy and, when f is not NULL, the forces on the free unknowns, at positions x. Returns the
  * energy; *fmax (if not NULL) receives the largest node force norm. */
 static double net_eval(const fs_spring_net *net, const double *x, double *f, double *fmax)
@@ -247,19 +275,11 @@ static double net_eval(const fs_spring_net *net, const double *x, double *f, dou
         if (k == 0.0)
             continue;
         int32_t i = net->anchor_node[a];
-        const double *xi = x + (size_t)dim * (size_t)i, *at = net->anchor_at + (size_t)dim * (size_t)a;
-        double d[3], r2 = 0.0;
-        for (int q = 0; q < dim; q++) {
-            d[q] = xi[q] - at[q];
-            r2 += d[q] * d[q];
-        }
-        double r = sqrt(r2), g = k;
-        if (slide > 0.0 && r > slide) {
+        double d[3], r2, g = anchor_pull(net, a, x, d, &r2), r = sqrt(r2);
+        if (slide > 0.0 && r > slide)
             energy += k * slide * (r - slide) + 0.5 * k * slide * slide;
-            g = k * slide / r;
-        } else {
+        else
             energy += 0.5 * k * r2;
-        }
         int32_t di = net->dof[i];
         if (f && di >= 0)
             for (int q = 0; q < dim; q++)
@@ -362,6 +382,11 @@ static void net_assemble(fs_spring_net *net)
         eps = 1e-300;
     for (int32_t j = 0; j < net->K.n; j++)
         net->K.values[net->K.col_ptr[j + 1] - 1] += eps;
+#ifdef FS_VALIDATE
+    char why[256];
+    FS_INVARIANT(fs_sparse_matrix_check(&net->K, why, sizeof why), "springs network, after assembling the tangent: %s",
+                 why);
+#endif
 }
 
 /* Assembles and factorizes at the current state, remembering it for downdates. */
@@ -402,49 +427,46 @@ static void net_step(const fs_spring_net *net, const double *x, const double *p,
     }
 }
 
+/* The tangent K and the factor M of an earlier one as fs_pcg's operator (solve/cg.h). */
+typedef struct {
+    fs_spring_net *net;
+    double target; /* of the Euclidean norm of the residual */
+} net_pcg_ctx;
+
+static void net_pcg_apply(void *ctx, const double *x, double *y)
+{
+    fs_sparse_matvec(&((net_pcg_ctx *)ctx)->net->K, x, y);
+}
+
+static int net_pcg_precondition(void *ctx, const double *r, double *z) { return net_solve(((net_pcg_ctx *)ctx)->net, r, z); }
+
+static bool net_pcg_converged(void *ctx, const double *r)
+{
+    const net_pcg_ctx *c = ctx;
+    return sqrt(fs_cg_dot(c->net->n_dof, r, r, FS_CG_SUM_SEQUENTIAL)) <= c->target;
+}
+
 /* Solves K p = f (K assembled at the current state) by conjugate gradients preconditioned with the
- * factor M, until ||K p - f|| <= target or max_it iterations. Returns the iterations used, max_it + 1
- * if not converged, -1 on a solver failure. r, z, d, q are n_dof scratch vectors. */
+ * factor M (fs_pcg from p = 0, sequential sums), until ||K p - f|| <= target or max_it iterations.
+ * Returns the iterations used, max_it + 1 if not converged (or a direction of no curvature after the
+ * first), -1 on a solver failure. r, z, d, q are n_dof scratch vectors. */
 static int net_pcg(fs_spring_net *net, const double *f, double *p, double target, int max_it, double *r, double *z,
                    double *d, double *q)
 {
-    int32_t nd = net->n_dof;
-    memset(p, 0, (size_t)nd * sizeof *p);
-    memcpy(r, f, (size_t)nd * sizeof *r);
-    if (net_solve(net, r, z) < 0)
+    net_pcg_ctx c = {net, target};
+    fs_cg_operator k = {net->n_dof, net_pcg_apply, net_pcg_precondition, net_pcg_converged, &c};
+    fs_pcg_params params = {max_it, FS_CG_SUM_SEQUENTIAL, true, false};
+    fs_pcg_result res = fs_pcg(&k, f, p, &params, (fs_pcg_vectors){r, z, d, q});
+    switch (res.status) {
+    case FS_PCG_CONVERGED:
+        return res.iterations;
+    case FS_PCG_BREAKDOWN:
+        return res.iterations == 0 ? -1 : max_it + 1;
+    case FS_PCG_MAX_ITERATIONS:
+        return max_it + 1;
+    default:
         return -1;
-    double rz = 0.0;
-    for (int32_t j = 0; j < nd; j++)
-        rz += r[j] * z[j];
-    memcpy(d, z, (size_t)nd * sizeof *d);
-    for (int it = 1; it <= max_it; it++) {
-        fs_sparse_matvec(&net->K, d, q);
-        double dq = 0.0;
-        for (int32_t j = 0; j < nd; j++)
-            dq += d[j] * q[j];
-        if (!(dq > 0.0))
-            return it == 1 ? -1 : max_it + 1;
-        double alpha = rz / dq, rr = 0.0;
-        for (int32_t j = 0; j < nd; j++) {
-            p[j] += alpha * d[j];
-            r[j] -= alpha * q[j];
-            rr += r[j] * r[j];
-        }
-        if (sqrt(rr) <= target)
-            return it;
-        if (it == max_it)
-            break;
-        if (net_solve(net, r, z) < 0)
-            return -1;
-        double rz_new = 0.0;
-        for (int32_t j = 0; j < nd; j++)
-            rz_new += r[j] * z[j];
-        double beta = rz_new / rz;
-        rz = rz_new;
-        for (int32_t j = 0; j < nd; j++)
-            d[j] = z[j] + beta * d[j];
     }
-    return max_it + 1;
 }
 
 /* design: inexact Newton. Each step assembles the tangent K at the current positions and solves
@@ -617,18 +639,9 @@ static void node_force(const fs_spring_net *net, int32_t i, const double *x, dou
     }
     for (int32_t p = net->anc_start[i]; p < net->anc_start[i + 1]; p++) {
         int32_t a = net->anc_list[p];
-        double k = net->anchor_k[a];
-        if (k == 0.0)
+        if (net->anchor_k[a] == 0.0)
             continue;
-        const double *xi = x + (size_t)dim * (size_t)i, *at = net->anchor_at + (size_t)dim * (size_t)a;
-        double d[3], r2 = 0.0;
-        for (int q = 0; q < dim; q++) {
-            d[q] = xi[q] - at[q];
-            r2 += d[q] * d[q];
-        }
-        double r = sqrt(r2), g = k;
-        if (net->slide > 0.0 && r > net->slide)
-            g = k * net->slide / r;
+        double d[3], r2, g = anchor_pull(net, a, x, d, &r2);
         for (int q = 0; q < dim; q++)
             out[q] -= g * d[q];
     }
@@ -644,9 +657,8 @@ static double norm_dim(const double *v, int dim)
 
 /* The region of a local relaxation and its scratch. */
 typedef struct {
-    int32_t n, cap;          /* region nodes */
-    int32_t *nodes;
-    int32_t *depth;
+    int32_t n;               /* region nodes */
+    int32_t *nodes;          /* n_nodes entries */
     int32_t ns, cap_s;       /* springs with an end in the region (each once), intact */
     int32_t *springs;
     double *H;               /* dim * dim per region spring */
@@ -662,38 +674,38 @@ static void region_clear(fs_spring_net *net, local_region *g)
     g->ns = 0;
 }
 
-static void region_push(fs_spring_net *net, local_region *g, int32_t node, int32_t depth)
+/* fs_region_edges_fn of a spring network: the intact springs of node i to free nodes, one hop each,
+ * in the order of its adjacency. */
+static void intact_springs(void *ctx, int32_t i, fs_region *r)
 {
-    if (g->n == g->cap) {
-        g->cap = g->cap ? 2 * g->cap : 256;
-        g->nodes = fs_realloc(g->nodes, (size_t)g->cap * sizeof *g->nodes);
-        g->depth = fs_realloc(g->depth, (size_t)g->cap * sizeof *g->depth);
+    const fs_spring_net *net = ctx;
+    for (int32_t p = net->adj_start[i]; p < net->adj_start[i + 1]; p++) {
+        int32_t s = net->adj_spring[p];
+        if (net->k[s] == 0.0)
+            continue;
+        int32_t j = net->node[2 * s] == i ? net->node[2 * s + 1] : net->node[2 * s];
+        if (net->dof[j] >= 0)
+            fs_region_reach(r, j, 1.0);
     }
-    net->local_map[node] = g->n;
-    g->nodes[g->n] = node;
-    g->depth[g->n++] = depth;
 }
 
-/* Breadth-first over intact springs from the seeds to the given depth, free nodes only. */
+/* Breadth-first over intact springs from the seeds to the given depth, free nodes only (geom/region.h
+ * with one hop per spring, ties by arrival: the nodes in the order of a breadth-first queue). */
 static void region_grow(fs_spring_net *net, local_region *g, const int32_t *seeds, int32_t n_seeds, int32_t radius)
 {
     region_clear(net, g);
+    int32_t *free_seeds = fs_malloc(((size_t)n_seeds + 1) * sizeof *free_seeds), n_free = 0;
     for (int32_t k = 0; k < n_seeds; k++)
-        if (net->dof[seeds[k]] >= 0 && net->local_map[seeds[k]] < 0)
-            region_push(net, g, seeds[k], 0);
-    for (int32_t head = 0; head < g->n; head++) {
-        int32_t i = g->nodes[head], dep = g->depth[head];
-        if (dep >= radius)
-            continue;
-        for (int32_t p = net->adj_start[i]; p < net->adj_start[i + 1]; p++) {
-            int32_t s = net->adj_spring[p];
-            if (net->k[s] == 0.0)
-                continue;
-            int32_t j = net->node[2 * s] == i ? net->node[2 * s + 1] : net->node[2 * s];
-            if (net->local_map[j] < 0 && net->dof[j] >= 0)
-                region_push(net, g, j, dep + 1);
-        }
-    }
+        if (net->dof[seeds[k]] >= 0)
+            free_seeds[n_free++] = seeds[k];
+    if (!g->nodes)
+        g->nodes = fs_malloc(((size_t)net->n_nodes + 1) * sizeof *g->nodes);
+    g->n = fs_region_grow(free_seeds, n_free, radius, FS_REGION_TIES_BY_ARRIVAL, intact_springs, net, net->local_dist,
+                          g->nodes);
+    fs_region_forget(net->local_dist, g->nodes, g->n);
+    for (int32_t k = 0; k < g->n; k++)
+        net->local_map[g->nodes[k]] = k;
+    free(free_seeds);
     for (int32_t k = 0; k < g->n; k++) {
         int32_t i = g->nodes[k];
         for (int32_t p = net->adj_start[i]; p < net->adj_start[i + 1]; p++) {
@@ -704,10 +716,7 @@ static void region_grow(fs_spring_net *net, local_region *g, const int32_t *seed
             int32_t other = a == i ? b : a;
             if (net->local_map[other] >= 0 && a != i)
                 continue; /* both ends inside: counted from its first end */
-            if (g->ns == g->cap_s) {
-                g->cap_s = g->cap_s ? 2 * g->cap_s : 1024;
-                g->springs = fs_realloc(g->springs, (size_t)g->cap_s * sizeof *g->springs);
-            }
+            FS_ARRAY_RESERVE(g->springs, g->cap_s, g->ns + 1, 1024);
             g->springs[g->ns++] = s;
         }
     }
@@ -724,7 +733,6 @@ static void region_free(fs_spring_net *net, local_region *g)
 {
     region_clear(net, g);
     free(g->nodes);
-    free(g->depth);
     free(g->springs);
     free(g->H);
     free(g->P);
@@ -833,19 +841,7 @@ static void invert_block(double *A, int dim)
         A[2] = -A[2] / det;
         return;
     }
-    double c[9];
-    c[0] = A[4] * A[8] - A[5] * A[7];
-    c[1] = A[2] * A[7] - A[1] * A[8];
-    c[2] = A[1] * A[5] - A[2] * A[4];
-    c[3] = A[5] * A[6] - A[3] * A[8];
-    c[4] = A[0] * A[8] - A[2] * A[6];
-    c[5] = A[2] * A[3] - A[0] * A[5];
-    c[6] = A[3] * A[7] - A[4] * A[6];
-    c[7] = A[1] * A[6] - A[0] * A[7];
-    c[8] = A[0] * A[4] - A[1] * A[3];
-    double det = A[0] * c[0] + A[1] * c[3] + A[2] * c[6];
-    for (int m = 0; m < 9; m++)
-        A[m] = c[m] / det;
+    fs_mat3_inverse(A, A);
 }
 
 /* y = K_RR v over the region (nodes outside held: their v is 0); D holds the diagonal blocks (springs,
@@ -894,18 +890,27 @@ static double region_max(const local_region *g, const double *v, int dim)
     return worst;
 }
 
-/* Solves K_RR p = f by block-Jacobi preconditioned CG until the largest node residual is below
- * target. D holds the diagonal blocks, g->P their inverses. Returns the iterations, or -1. */
-static int region_cg(const fs_spring_net *net, local_region *g, const double *D, double target)
+/* The region's K_RR and its block-Jacobi preconditioner as fs_pcg's operator (solve/cg.h). */
+typedef struct {
+    const fs_spring_net *net;
+    const local_region *g;
+    const double *D;  /* the diagonal blocks (g->P holds their inverses) */
+    double target;    /* of the largest node residual */
+} region_pcg_ctx;
+
+static void region_pcg_apply(void *ctx, const double *x, double *y)
 {
-    int dim = net->dim, dd = dim * dim;
-    size_t nv = (size_t)g->n * (size_t)dim;
-    memset(g->p, 0, nv * sizeof *g->p);
-    memcpy(g->r, g->f, nv * sizeof *g->r);
-    double rz = 0.0;
-    for (int32_t k = 0; k < g->n; k++) {
-        const double *P = g->P + (size_t)dd * (size_t)k, *rk = g->r + (size_t)dim * (size_t)k;
-        double *zk = g->z + (size_t)dim * (size_t)k;
+    const region_pcg_ctx *c = ctx;
+    region_apply(c->net, c->g, c->D, x, y);
+}
+
+static int region_pcg_precondition(void *ctx, const double *r, double *z)
+{
+    const region_pcg_ctx *c = ctx;
+    int dim = c->net->dim, dd = dim * dim;
+    for (int32_t k = 0; k < c->g->n; k++) {
+        const double *P = c->g->P + (size_t)dd * (size_t)k, *rk = r + (size_t)dim * (size_t)k;
+        double *zk = z + (size_t)dim * (size_t)k;
         for (int p = 0; p < dim; p++) {
             double acc = 0.0;
             for (int q = 0; q < dim; q++)
@@ -913,42 +918,28 @@ static int region_cg(const fs_spring_net *net, local_region *g, const double *D,
             zk[p] = acc;
         }
     }
-    for (size_t m = 0; m < nv; m++)
-        rz += g->r[m] * g->z[m];
-    memcpy(g->d, g->z, nv * sizeof *g->d);
-    int max_it = 50 + 10 * (int)sqrt((double)g->n) + 2000;
-    for (int it = 1; it <= max_it; it++) {
-        region_apply(net, g, D, g->d, g->q);
-        double dq = 0.0;
-        for (size_t m = 0; m < nv; m++)
-            dq += g->d[m] * g->q[m];
-        if (!(dq > 0.0))
-            return rz == 0.0 ? it : -1;
-        double alpha = rz / dq;
-        for (size_t m = 0; m < nv; m++) {
-            g->p[m] += alpha * g->d[m];
-            g->r[m] -= alpha * g->q[m];
-        }
-        if (region_max(g, g->r, dim) <= target)
-            return it;
-        double rz_new = 0.0;
-        for (int32_t k = 0; k < g->n; k++) {
-            const double *P = g->P + (size_t)dd * (size_t)k, *rk = g->r + (size_t)dim * (size_t)k;
-            double *zk = g->z + (size_t)dim * (size_t)k;
-            for (int p = 0; p < dim; p++) {
-                double acc = 0.0;
-                for (int q = 0; q < dim; q++)
-                    acc += P[p * dim + q] * rk[q];
-                zk[p] = acc;
-            }
-        }
-        for (size_t m = 0; m < nv; m++)
-            rz_new += g->r[m] * g->z[m];
-        double beta = rz_new / rz;
-        rz = rz_new;
-        for (size_t m = 0; m < nv; m++)
-            g->d[m] = g->z[m] + beta * g->d[m];
-    }
+    return 0;
+}
+
+static bool region_pcg_converged(void *ctx, const double *r)
+{
+    const region_pcg_ctx *c = ctx;
+    return region_max(c->g, r, c->net->dim) <= c->target;
+}
+
+/* Solves K_RR p = f by block-Jacobi preconditioned CG (fs_pcg from p = 0, sequential sums) until the
+ * largest node residual is below target. D holds the diagonal blocks, g->P their inverses. Returns
+ * the iterations (a direction of no curvature with nothing left to reduce counts as converged), or -1. */
+static int region_cg(const fs_spring_net *net, local_region *g, const double *D, double target)
+{
+    region_pcg_ctx c = {net, g, D, target};
+    fs_cg_operator k = {g->n * net->dim, region_pcg_apply, region_pcg_precondition, region_pcg_converged, &c};
+    fs_pcg_params params = {50 + 10 * (int)sqrt((double)g->n) + 2000, FS_CG_SUM_SEQUENTIAL, true, false};
+    fs_pcg_result res = fs_pcg(&k, g->f, g->p, &params, (fs_pcg_vectors){g->r, g->z, g->d, g->q});
+    if (res.status == FS_PCG_CONVERGED)
+        return res.iterations;
+    if (res.status == FS_PCG_BREAKDOWN && res.rz == 0.0)
+        return res.iterations + 1;
     return -1;
 }
 

@@ -5,16 +5,21 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/sort.h"
 #include "base/vec.h"
+#include "fracture/eigen.h"
 #include "fracture/event.h"
 #include "fracture/rank.h"
 #include "fracture/separation.h"
+#include "geom/region.h"
 #include "model/tet/element.h"
 #include "solve/cg.h"
 
+/* Nodes with at most this many elements keep their element forces on the stack. */
+#define NODE_TETS_ON_STACK 64
 /* Event searches start with this fraction of the time left. */
 #define SEARCH_FIRST_STEP 0.125
 /* A node is searched again after a relaxation when one of its elements' stresses changed by more
@@ -47,8 +52,8 @@ static int corner_of(const fs_tetmesh *m, int32_t t, int32_t node)
 double fs_tet_node_ratio(const fs_tet *s, int32_t i, const double *c, int *kind, double normal[3])
 {
     const fs_tet_list *l = &s->mesh.node_tets[i];
-    fs_separation sep;
-    fs_separation_init(&sep);
+    double buf[2 * 3 * NODE_TETS_ON_STACK] = {0.0};
+    double *fp = l->n <= NODE_TETS_ON_STACK ? buf : fs_malloc(6 * (size_t)l->n * sizeof *fp), *fm = fp + 3 * l->n;
     double fint[3] = {0.0, 0.0, 0.0};
     for (int32_t q = 0; q < l->n; q++) {
         int32_t t = l->v[q];
@@ -57,7 +62,7 @@ double fs_tet_node_ratio(const fs_tet *s, int32_t i, const double *c, int *kind,
         double sigma[6], plus[6], minus[6];
         if (c) {
             fs_tet_stress_at(s, t, c, sigma);
-            fs_separation_split(sigma, plus, minus);
+            fs_separation_split_stress(sigma, plus, minus);
         } else {
             const double *ref = s->split_ref + 12 * (size_t)t;
             for (int k = 0; k < 6; k++) {
@@ -65,22 +70,24 @@ double fs_tet_node_ratio(const fs_tet *s, int32_t i, const double *c, int *kind,
                 minus[k] = ref[k] - ref[6 + k];
             }
         }
-        double fp[3], fm[3], vol = s->vol[t];
-        fp[0] = -vol * (plus[0] * g[0] + plus[3] * g[1] + plus[5] * g[2]);
-        fp[1] = -vol * (plus[3] * g[0] + plus[1] * g[1] + plus[4] * g[2]);
-        fp[2] = -vol * (plus[5] * g[0] + plus[4] * g[1] + plus[2] * g[2]);
-        fm[0] = -vol * (minus[0] * g[0] + minus[3] * g[1] + minus[5] * g[2]);
-        fm[1] = -vol * (minus[3] * g[0] + minus[1] * g[1] + minus[4] * g[2]);
-        fm[2] = -vol * (minus[5] * g[0] + minus[4] * g[1] + minus[2] * g[2]);
-        fs_separation_add(&sep, fp, fm);
+        double vol = s->vol[t], *p = fp + 3 * q, *m = fm + 3 * q;
+        p[0] = -vol * (plus[0] * g[0] + plus[3] * g[1] + plus[5] * g[2]);
+        p[1] = -vol * (plus[3] * g[0] + plus[1] * g[1] + plus[4] * g[2]);
+        p[2] = -vol * (plus[5] * g[0] + plus[4] * g[1] + plus[2] * g[2]);
+        m[0] = -vol * (minus[0] * g[0] + minus[3] * g[1] + minus[5] * g[2]);
+        m[1] = -vol * (minus[3] * g[0] + minus[1] * g[1] + minus[4] * g[2]);
+        m[2] = -vol * (minus[5] * g[0] + minus[4] * g[1] + minus[2] * g[2]);
         for (int k = 0; k < 3; k++)
-            fint[k] += fp[k] + fm[k];
+            fint[k] += p[k] + m[k];
     }
     /* the largest eigenvalue whose plane cuts the node's elements (O'Brien & Hodgins: further planes
      * for further eigenvalues); a node on a crack wall pulled across the wall cannot split along it */
-    double zeta[6], value[3], vec[9], ratio = 0.0;
-    fs_separation_tensor(&sep, zeta);
-    fs_separation_eigen(zeta, value, vec);
+    double zeta[9], value[3], vec[9], ratio = 0.0;
+    fs_separation_tensor(fp, l->n, fm, l->n, zeta);
+    if (fp != buf)
+        free(fp);
+    if (fs_eigen_sym3(zeta, value, vec) < 0)
+        value[0] = value[1] = value[2] = 0.0;
     *kind = 0;
     if (normal)
         normal[0] = normal[1] = normal[2] = 0.0;
@@ -101,12 +108,11 @@ double fs_tet_node_ratio(const fs_tet *s, int32_t i, const double *c, int *kind,
         break;
     }
     if (s->bonded[i] && s->par.bond > 0.0 && s->area[i] > 0.0) {
-        /* the pull of the layer on its bond: the normal part when it lifts, and the shear */
+        /* the pull of the layer off its substrate (peeling; the shear that holds the layer's
+         * shrinkage is the bond's job and does not loosen it here) */
         double nn[3];
         fs_tet_normal(s, i, nn);
-        double up = fs_dot3(fint, nn), shear2 = fs_dot3(fint, fint) - up * up;
-        double pull = sqrt(fmax(up, 0.0) * fmax(up, 0.0) + fmax(shear2, 0.0));
-        double rb = pull / (s->area[i] * 1e-3 * s->par.bond);
+        double rb = fs_dot3(fint, nn) / (s->area[i] * 1e-3 * s->par.bond);
         if (rb > ratio) {
             ratio = rb;
             *kind = 1;
@@ -185,28 +191,6 @@ static void next_stamp(fs_tet *s)
         memset(s->stamp, 0, (size_t)s->cap_nodes * sizeof *s->stamp);
         s->stamp_now = 1;
     }
-}
-
-/* Appends to *list (growing) the nodes adjacent to list[from..n) not yet stamped, stamping them. */
-static int32_t add_ring(fs_tet *s, int32_t **list, int32_t n, int32_t from, int32_t *cap)
-{
-    int32_t end = n;
-    for (int32_t q = from; q < end; q++) {
-        const fs_tet_list *l = &s->mesh.node_tets[(*list)[q]];
-        for (int32_t k = 0; k < l->n; k++)
-            for (int c = 0; c < 4; c++) {
-                int32_t v = s->mesh.tet[4 * (size_t)l->v[k] + c];
-                if (s->stamp[v] == s->stamp_now)
-                    continue;
-                s->stamp[v] = s->stamp_now;
-                if (n == *cap) {
-                    *cap = 2 * *cap + 64;
-                    *list = fs_realloc(*list, (size_t)*cap * sizeof **list);
-                }
-                (*list)[n++] = v;
-            }
-    }
-    return n;
 }
 
 /* The tetrahedra of the listed nodes, each once, in the order the nodes list them, into *out
@@ -466,44 +450,47 @@ static int solve_region(fs_tet *s, const int32_t *region, int32_t nr, const int3
  * equilibrium before) must then be below relax_tolerance times a typical element force of that
  * load, else the region grows by two rings and the solve is repeated. Every element the solve moved
  * gets its stresses again, and every node of those elements a new event search from now. */
+/* The connections of node i for the region search: to every other corner of its elements, one hop. */
+static void node_links(void *ctx, int32_t i, fs_region *r)
+{
+    const fs_tet *s = ctx;
+    const fs_tet_list *l = &s->mesh.node_tets[i];
+    for (int32_t q = 0; q < l->n; q++)
+        for (int c = 0; c < 4; c++) {
+            int32_t j = s->mesh.tet[4 * (size_t)l->v[q] + c];
+            if (j != i)
+                fs_region_reach(r, j, 1.0);
+        }
+}
+
 int fs_tet_relax_local(fs_tet *s, const int32_t *nodes, int32_t n)
 {
     double t0 = fs_seconds();
-    int32_t cap = 4 * n + 256, nr = 0;
-    int32_t *region = fs_malloc((size_t)cap * sizeof *region);
-    next_stamp(s);
-    for (int32_t q = 0; q < n; q++)
-        if (s->stamp[nodes[q]] != s->stamp_now) {
-            s->stamp[nodes[q]] = s->stamp_now;
-            region[nr++] = nodes[q];
-        }
-    int rings = (int)ceil(s->cfg.solver.relax_radius);
-    int32_t from = 0;
-    for (int r = 0; r < rings; r++) {
-        int32_t before = nr;
-        nr = add_ring(s, &region, nr, from, &cap);
-        from = before;
+    if (s->cap_region < s->mesh.n_nodes) {
+        int32_t old = s->cap_region;
+        s->cap_region = s->cap_nodes;
+        FS_ARRAY_RESIZE(s->region, s->cap_region);
+        FS_ARRAY_RESIZE(s->dist, s->cap_region);
+        for (int32_t i = old; i < s->cap_region; i++)
+            s->dist[i] = INFINITY;
     }
-    int32_t *tets = NULL, tcap = 0, nt = 0, moved = 0;
+    int32_t *region = s->region, *tets = NULL, tcap = 0, nt = 0, moved = 0;
+    double radius = ceil(s->cfg.solver.relax_radius);
     int rc = 0;
     for (;;) {
+        /* the nodes within radius hops of the changed ones, then those one hop further out */
+        int32_t all = fs_region_grow(nodes, n, radius + 1.0, FS_REGION_TIES_BY_ARRIVAL, node_links, s, s->dist, region);
+        int32_t nr = 0;
+        while (nr < all && s->dist[region[nr]] <= radius)
+            nr++;
         nt = tets_of(s, region, nr, &tets, &tcap);
-        if ((rc = solve_region(s, region, nr, tets, nt)) < 0)
-            break;
-        /* the ring outside: its residual decides */
-        int32_t before = nr;
-        int32_t with_ring = add_ring(s, &region, nr, from, &cap);
-        bool done = with_ring == before || residual_small(s, region + before, with_ring - before);
-        moved = before;
-        nr = with_ring;
-        from = before;
+        rc = solve_region(s, region, nr, tets, nt);
+        bool done = rc < 0 || nr == all || residual_small(s, region + nr, all - nr);
+        fs_region_forget(s->dist, region, all);
+        moved = nr;
         if (done)
             break;
-        for (int r = 1; r < RELAX_GROW_RINGS; r++) {
-            int32_t b2 = nr;
-            nr = add_ring(s, &region, nr, from, &cap);
-            from = b2;
-        }
+        radius += RELAX_GROW_RINGS;
     }
     /* the elements of the moved nodes get their stresses again; the nodes of those whose stresses
      * changed by more than SEARCH_AGAIN of a typical stress, and the given ones, are searched again */
@@ -555,7 +542,6 @@ int fs_tet_relax_local(fs_tet *s, const int32_t *nodes, int32_t n)
     free(touched);
     s->counters.search_seconds += fs_seconds() - t1;
     free(tets);
-    free(region);
     return rc;
 }
 
@@ -664,12 +650,12 @@ int fs_tet_debond(fs_tet *s, int32_t i)
     s->bonded[i] = 0;
     fs_tet_number_dofs(s);
     /* the node and its neighbours: their bonded areas change */
-    int32_t cap = 64, n = 1;
-    int32_t *nodes = fs_malloc((size_t)cap * sizeof *nodes);
-    nodes[0] = i;
-    next_stamp(s);
-    s->stamp[i] = s->stamp_now;
-    n = add_ring(s, &nodes, n, 0, &cap);
+    int32_t *nodes = fs_malloc((size_t)s->mesh.n_nodes * sizeof *nodes);
+    double *dist = fs_malloc((size_t)s->mesh.n_nodes * sizeof *dist);
+    for (int32_t q = 0; q < s->mesh.n_nodes; q++)
+        dist[q] = INFINITY;
+    int32_t n = fs_region_grow(&i, 1, 1.0, FS_REGION_TIES_BY_ARRIVAL, node_links, s, dist, nodes);
+    free(dist);
     for (int32_t q = 0; q < n; q++)
         s->area[nodes[q]] = bond_area(s, nodes[q]);
     int rc = fs_tet_relax_local(s, nodes, n);

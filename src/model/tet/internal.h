@@ -92,6 +92,9 @@ struct fs_tet {
     int32_t cap_map;
     int32_t *tet_slot;          /* scratch per tetrahedron: its place in a local system's list */
     int32_t cap_slot;
+    int32_t *region;            /* scratch per node: a relaxation's region (geom/region.h) */
+    double *dist;               /* scratch per node: its distances, INFINITY between searches */
+    int32_t cap_region;
     int32_t *tet_stamp;         /* scratch per tetrahedron: marks (compared with tet_stamp_now) */
     int32_t tet_stamp_now, cap_tet_stamp;
     int64_t events;

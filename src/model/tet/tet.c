@@ -92,6 +92,8 @@ void fs_tet_free(fs_tet *s)
     free(s->dof_map);
     free(s->tet_slot);
     free(s->tet_stamp);
+    free(s->region);
+    free(s->dist);
     fs_tetcut_result_free(&s->cut);
     memset(s, 0, sizeof *s);
 }
@@ -275,9 +277,9 @@ void fs_tet_update_stress(fs_tet *s, int32_t t)
         fs_tet_stress(s->lambda[t], s->mu[t], eps, s->stress + 6 * ((size_t)nl * t + k));
     }
     if (s->proportional) {
-        double *ref = s->split_ref + 12 * (size_t)t, minus[6];
+        double *ref = s->split_ref + 12 * (size_t)t;
         fs_tet_stress_at(s, t, s->c_ref, ref);
-        fs_separation_split(ref, ref + 6, minus);
+        fs_separation_split_stress(ref, ref + 6, NULL);
     }
 }
 

@@ -3,11 +3,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/sort.h"
 #include "base/vec.h"
 #include "fracture/eigen.h"
+#include "fracture/separation.h"
 #include "geom/refine.h"
 #include "model/wedge/internal.h"
 #include "model/wedge/frame.h"
@@ -140,12 +142,10 @@ static int nodal_ratio(const fs_wedge_model *w, int32_t node, double *ratio, dou
     for (int32_t p = w->node_elem_start[node]; p < w->node_elem_start[node] + w->node_elem_count[node]; p++)
         if (w->state[w->node_elem[p]] == FS_WEDGE_ALIVE)
             thr += w->threshold[w->node_elem[p]];
-    double sigma[3], dirs[9];
-    if (fs_eigen_principal_stress(s, sigma, dirs) < 0)
+    double sigma1;
+    if (fs_nodal_principal_plane(s, &sigma1, m) < 0)
         return -1;
-    *ratio = sigma[0] / (thr / count);
-    if (m)
-        memcpy(m, dirs, 3 * sizeof *m);
+    *ratio = sigma1 / (thr / count);
     return 0;
 }
 
@@ -402,12 +402,11 @@ static bool fan_of(const fs_wedge_model *w, int32_t i, const fs_wedge_frame *f, 
             if (u < 0 || w->state[u] != FS_WEDGE_ALIVE)
                 return false;
         }
-        if (fan->n == fan->cap) {
-            fan->cap = fan->cap ? 2 * fan->cap : 16;
-            fan->a = fs_realloc(fan->a, (size_t)fan->cap * sizeof *fan->a);
-            fan->b = fs_realloc(fan->b, (size_t)fan->cap * sizeof *fan->b);
-            fan->ra = fs_realloc(fan->ra, 2 * (size_t)fan->cap * sizeof *fan->ra);
-            fan->rb = fs_realloc(fan->rb, 2 * (size_t)fan->cap * sizeof *fan->rb);
+        if (FS_ARRAY_GROW(fan->cap, fan->n + 1, 16)) {
+            FS_ARRAY_RESIZE(fan->a, fan->cap);
+            FS_ARRAY_RESIZE(fan->b, fan->cap);
+            FS_ARRAY_RESIZE(fan->ra, 2 * (size_t)fan->cap);
+            FS_ARRAY_RESIZE(fan->rb, 2 * (size_t)fan->cap);
         }
         double pi[3], pa[3], pb[3], d[3];
         fs_mesh_corner(m, t, c, pi);
