@@ -57,6 +57,13 @@ enum {
 /* Most time-lapse frames one run writes. */
 #define MAX_FRAMES 10000
 
+/* Longest -n/--name in bytes: with the longest suffix fissure adds (a frame's
+ * "_frame_NNNN_crackmask.png", a glTF "_occlusionRoughnessMetallic.png", "T_" before an Unreal map)
+ * and the staging name's ".", ".tmp-PID-N", every file name stays under NAME_MAX (255). */
+#define MAX_NAME_BYTES 128
+/* Longest file name a run stages for a NAME of n bytes, as fs_output_check wants it. */
+#define STAGED_NAME_BYTES(n) ((n) + 2 + 31 + 1 + 5 + 20 + 1 + 20)
+
 static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},
     {"name", required_argument, NULL, 'n'},
@@ -120,6 +127,37 @@ static void print_help(FILE *out)
           out);
 }
 
+/* Whether s is UTF-8 (shortest forms, no surrogates, at most U+10FFFF). */
+static bool utf8_valid(const char *s)
+{
+    const unsigned char *p = (const unsigned char *)s;
+    while (*p) {
+        unsigned c = *p;
+        int more = c < 0x80 ? 0 : (c & 0xe0) == 0xc0 ? 1 : (c & 0xf0) == 0xe0 ? 2 : (c & 0xf8) == 0xf0 ? 3 : -1;
+        if (more < 0 || (more == 1 && c < 0xc2))
+            return false;
+        unsigned cp = more == 0 ? c : c & (0x3fu >> more);
+        for (int k = 1; k <= more; k++) {
+            if ((p[k] & 0xc0) != 0x80)
+                return false;
+            cp = (cp << 6) | (p[k] & 0x3fu);
+        }
+        if ((more == 2 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) || (more == 3 && (cp < 0x10000 || cp > 0x10ffff)))
+            return false;
+        p += more + 1;
+    }
+    return true;
+}
+
+/* Whether s has a control character (a newline would break "one path a line" on stdout). */
+static bool has_control(const char *s)
+{
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++)
+        if (*p < 0x20 || *p == 0x7f)
+            return true;
+    return false;
+}
+
 static int usage_error(const char *fmt, const char *arg)
 {
     fputs("fissure: ", stderr);
@@ -172,10 +210,18 @@ static int parse_options(int argc, char **argv, options *o)
     int c;
     while ((c = getopt_long(argc, argv, "o:n:s:j:qvhV", long_options, NULL)) != -1) {
         switch (c) {
-        case 'o': o->output_dir = optarg; break;
+        case 'o':
+            if (has_control(optarg))
+                return usage_error("--output: expected a directory name without control characters, got '%s'",
+                                   optarg);
+            o->output_dir = optarg;
+            break;
         case 'n':
-            if (!*optarg || strchr(optarg, '/'))
-                return usage_error("--name: expected a file name prefix without '/', got '%s'", optarg);
+            if (!*optarg || strchr(optarg, '/') || has_control(optarg) || !utf8_valid(optarg) ||
+                strlen(optarg) > MAX_NAME_BYTES)
+                return usage_error("--name: expected a file name prefix of 1 to 128 bytes of UTF-8 without '/' or "
+                                   "control characters, got '%s'",
+                                   optarg);
             o->name = optarg;
             break;
         case 's': {
@@ -246,8 +292,8 @@ static int parse_options(int argc, char **argv, options *o)
         case OPT_LIST: o->list_presets = true; break;
         case OPT_DUMP: o->dump_preset = true; break;
         case OPT_MESH:
-            if (!*optarg || optarg[strlen(optarg) - 1] == '/')
-                return usage_error("--mesh: expected a file name, got '%s'", optarg);
+            if (!*optarg || optarg[strlen(optarg) - 1] == '/' || has_control(optarg))
+                return usage_error("--mesh: expected a file name without control characters, got '%s'", optarg);
             o->mesh_path = optarg;
             break;
         case 'h': print_help(stdout); return -1;
@@ -345,6 +391,26 @@ static fs_output *stage_mesh(const char *path, const fs_config *cfg, const fs_re
         return NULL;
     }
     return out;
+}
+
+/* Checks, before the run, that the outputs can be created: the output directory (or the ancestor
+ * it would be created in) and the --mesh file's directory are writable directories. */
+static int check_outputs(const options *o, const char *name)
+{
+    if (fs_output_check(o->output_dir, STAGED_NAME_BYTES(strlen(name))) < 0)
+        return -1;
+    if (!o->mesh_path)
+        return 0;
+    char *dir = fs_strdup(o->mesh_path);
+    char *slash = strrchr(dir, '/');
+    const char *file = slash ? o->mesh_path + (slash - dir) + 1 : o->mesh_path;
+    if (!slash)
+        strcpy(dir, ".");
+    else
+        slash[slash == dir ? 1 : 0] = '\0';
+    int rc = fs_output_check(dir, strlen(file) + 1 + 5 + 20 + 1 + 20);
+    free(dir);
+    return rc;
 }
 
 /* Map kinds a time-lapse frame can have: the texture-space rasters. */
@@ -506,6 +572,12 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
     fs_output *mesh_out = NULL;
     if (rc == 0 && o->mesh_path && !(mesh_out = stage_mesh(o->mesh_path, cfg, res, name)))
         rc = -1;
+    /* one set: the frames and the mesh are committed with the maps, the sidecar that lists them last */
+    fs_output_merge(out, fw->out);
+    fw->out = NULL;
+    fs_output_merge(out, mesh_out);
+    int n_files;
+    const char **files = fs_output_names(out, &n_files);
     char json_name[600];
     snprintf(json_name, sizeof json_name, "%s.json", name);
     char frame_pattern[600];
@@ -513,33 +585,19 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
     fs_sidecar_frames frames = {o->frames, frame_pattern, fw->time, fw->fractures, fw->height_min, fw->height_max,
                                 fw->map, fw->n_kinds};
     if (rc == 0)
-        rc = fs_sidecar_write(fs_output_stage(out, json_name), cfg, preset_text, &res->stats, maps,
+        rc = fs_sidecar_write(fs_output_stage_seal(out, json_name), cfg, preset_text, &res->stats, maps,
                               fs_target_name(o->target), written->map, written->n, o->frames ? &frames : NULL,
-                              fs_seconds() - t_start);
+                              files, n_files, fs_seconds() - t_start);
+    free(files);
     fs_target_output_free(written);
     const int n = written->n;
+    fs_image_free(&exr_height);
     if (rc < 0) {
         free(written);
-        fs_image_free(&exr_height);
         fs_output_abort(out);
-        if (mesh_out)
-            fs_output_abort(mesh_out);
         return -1;
     }
-    fs_image_free(&exr_height);
     if (fs_output_commit(out) < 0) {
-        free(written);
-        if (mesh_out)
-            fs_output_abort(mesh_out);
-        return -1;
-    }
-    if (mesh_out && fs_output_commit(mesh_out) < 0) {
-        free(written);
-        return -1;
-    }
-    fs_output *frames_out = fw->out;
-    fw->out = NULL;
-    if (frames_out && fs_output_commit(frames_out) < 0) {
         free(written);
         return -1;
     }
@@ -573,8 +631,12 @@ static int run(const char *preset_arg, const options *o)
         return usage_error("--frames: %s", "the voronoi model has no time to show frames of; expected a springs or "
                                            "wedge preset");
     }
-    char *preset_text = read_text(preset_path);
     const char *name = o->name ? o->name : cfg.preset.name;
+    if (check_outputs(o, name) < 0) {
+        free(preset_path);
+        return fail();
+    }
+    char *preset_text = read_text(preset_path);
     fs_info("%s: %s model on a %s, %d elements, seed %" PRIu64 ", %dx%d maps", preset_path,
             fs_model_name(cfg.preset.model), fs_domain_type_name(cfg.domain.type), (int)cfg.mesh.elements,
             cfg.preset.seed, cfg.render.width, cfg.render.height);
@@ -619,6 +681,19 @@ static int run(const char *preset_arg, const options *o)
     return 0;
 }
 
+/* Runs before the shared libraries' constructors, some of which start threads (OpenBLAS its pool):
+ * blocking the termination signals here gives every thread of the process the blocked mask, so
+ * that only fissure's cleanup thread takes them (io/output.h). */
+static void block_signals_early(int argc, char **argv, char **envp)
+{
+    (void)argc;
+    (void)argv;
+    (void)envp;
+    fs_output_block_signals();
+}
+__attribute__((section(".preinit_array"), used)) static void (*const preinit_block_signals)(int, char **,
+                                                                                          char **) = block_signals_early;
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && !strcmp(argv[1], "diff"))
@@ -639,6 +714,10 @@ int main(int argc, char **argv)
     if (optind != argc - 1) {
         free(o.sets);
         return usage_error("%s", optind >= argc ? "missing PRESET argument" : "expected exactly one PRESET argument");
+    }
+    if (fs_output_cleanup_on_signals() < 0) {
+        free(o.sets);
+        return fail();
     }
     rc = run(argv[optind], &o);
     free(o.sets);

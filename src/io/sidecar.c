@@ -95,7 +95,7 @@ static json_t *map_entry(const fs_sidecar_map *m, const fs_config *cfg, const fs
 
 int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_text, const fs_stats *stats,
                      const fs_maps *maps, const char *target, const fs_sidecar_map *list, int n_maps,
-                     const fs_sidecar_frames *frames, double wall_seconds)
+                     const fs_sidecar_frames *frames, const char *const *files, int n_files, double wall_seconds)
 {
     json_t *root = json_object();
     json_object_set_new(root, "generator", json_string("fissure"));
@@ -156,6 +156,19 @@ int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_
         json_object_set_new(jf, "frames", list_f);
         json_object_set_new(root, "frames", jf);
     }
+
+    json_t *jfiles = json_array();
+    for (int i = 0; i < n_files; i++) {
+        json_t *f = json_string(files[i]);
+        if (!f) {
+            json_decref(jfiles);
+            json_decref(root);
+            fs_error(FS_ERR_CANTCREAT, "%s: the sidecar cannot list a file name that is not UTF-8", files[i]);
+            return -1;
+        }
+        json_array_append_new(jfiles, f);
+    }
+    json_object_set_new(root, "files", jfiles);
 
     int rc = json_dump_file(root, path, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10));
     json_decref(root);
