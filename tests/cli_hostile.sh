@@ -32,4 +32,60 @@ voronoi-trunk domain.radius=1e-300 mesh.min_size=1e-301
 voronoi-sphere domain.radius=1e-300 mesh.min_size=1e-301
 sphere domain.radius=1e-300 mesh.min_size=1e-301
 EOF
+# Special files: a device (/dev/zero) was read without end, growing 250 MB/s; a FIFO named *.ini on the
+# preset path blocked --list-presets and name look-ups. Only regular files are read, opened without
+# blocking.
+bounded 10 66 "/dev/zero as the preset: exit 66" "$FISSURE" -q -o "$tmp/special" /dev/zero
+grep -q "/dev/zero: cannot open preset: not a regular file" "$tmp/stderr" && ok "/dev/zero: the message says why" \
+    || not_ok "/dev/zero: the message says why"
+mkdir "$tmp/path"
+cp "$PRESETS/voronoi-tile.ini" "$tmp/path/mine.ini"
+if mkfifo "$tmp/path/fifo.ini"; then
+    FISSURE_PRESET_PATH="$tmp/path" bounded 10 0 "a FIFO on the preset path: --list-presets" "$FISSURE" --list-presets
+    grep -q "^voronoi-tile" "$tmp/stdout" && ok "--list-presets lists the regular files" \
+        || not_ok "--list-presets lists the regular files"
+    grep -q "fifo" "$tmp/stdout" && not_ok "--list-presets skips the FIFO" || ok "--list-presets skips the FIFO"
+    FISSURE_PRESET_PATH="$tmp/path" bounded 10 66 "a FIFO on the preset path: a look-up by name" "$FISSURE" \
+        --dump-preset no-such-preset
+    FISSURE_PRESET_PATH="$tmp/path" bounded 10 66 "the FIFO named: exit 66" "$FISSURE" --dump-preset fifo
+    grep -q "not a regular file" "$tmp/stderr" && ok "the FIFO named: the message says why" \
+        || not_ok "the FIFO named: the message says why"
+fi
+# The preset size limit (1 MiB, fissure-preset(5)).
+awk 'BEGIN { printf "#"; for (i = 0; i < 1048576; i++) printf "a"; print "" }' > "$tmp/big.ini"
+expect_status 65 "a preset over 1 MiB: exit 65" "$FISSURE" --dump-preset "$tmp/big.ini"
+grep -q "expected at most 1048576 bytes (1 MiB)" "$tmp/stderr" && ok "the message gives the limit" \
+    || not_ok "the message gives the limit"
+
+# A directory or a symlink loop given as a bare name says why it cannot be read (it said "no such
+# file"); a directory named like a preset does not hide the preset.
+mkdir "$tmp/cwd" "$tmp/cwd/adir" "$tmp/cwd/mud"
+ln -s loop-b "$tmp/cwd/loop-a" && ln -s loop-a "$tmp/cwd/loop-b"
+(cd "$tmp/cwd" && "$FISSURE" --dump-preset adir) >/dev/null 2>"$tmp/stderr"; status=$?
+[ "$status" -eq 66 ] && grep -q "adir: cannot open preset: Is a directory, and not on the preset path" "$tmp/stderr" \
+    && ok "a directory as a bare name: Is a directory" || { not_ok "a directory as a bare name"; head -2 "$tmp/stderr"; }
+(cd "$tmp/cwd" && "$FISSURE" --dump-preset loop-a) >/dev/null 2>"$tmp/stderr"; status=$?
+[ "$status" -eq 66 ] && grep -q "loop-a: cannot open preset: Too many levels of symbolic links, and not" "$tmp/stderr" \
+    && ok "a symlink loop as a bare name: Too many levels of symbolic links" \
+    || { not_ok "a symlink loop as a bare name"; head -2 "$tmp/stderr"; }
+(cd "$tmp/cwd" && "$FISSURE" --dump-preset mud) >"$tmp/stdout" 2>&1 && grep -q "^name = mud$" "$tmp/stdout" \
+    && ok "a directory named mud does not hide the preset mud" || not_ok "a directory named mud hides the preset"
+
+# Numbers are decimal: hexadecimal, which strtod reads, is refused where fissure-preset(5) says decimal.
+for v in 0x10 0x1p3; do
+    expect_status 65 "--set voronoi.warp=$v: exit 65" "$FISSURE" --dump-preset --set voronoi.warp=$v voronoi-tile
+    printf '[voronoi]\nwarp = %s\n' "$v" > "$tmp/hex.ini"
+    expect_status 65 "warp = $v in a preset: exit 65" "$FISSURE" --dump-preset "$tmp/hex.ini"
+    grep -q "hex.ini:2: \[voronoi\] warp: expected a number >= 0 (cm), got '$v'" "$tmp/stderr" \
+        && ok "warp = $v: the message names the line" || not_ok "warp = $v: the message names the line"
+done
+
+# --dump-preset round-trips every value it accepts: one starting with ';' (dumped as "key = ;x", read
+# back as a comment) is refused, '#' is kept.
+printf '[preset]\ndescription =;x\n' > "$tmp/semi.ini"
+expect_status 65 "description =;x: exit 65" "$FISSURE" --dump-preset "$tmp/semi.ini"
+printf '[preset]\ndescription =#x ;y\n' > "$tmp/hash.ini"
+"$FISSURE" --dump-preset "$tmp/hash.ini" > "$tmp/d1.ini" && "$FISSURE" --dump-preset "$tmp/d1.ini" > "$tmp/d2.ini" \
+    && cmp -s "$tmp/d1.ini" "$tmp/d2.ini" && grep -q "^description = #x$" "$tmp/d1.ini" \
+    && ok "description =#x: dump, parse, dump is stable" || not_ok "description =#x: dump, parse, dump is stable"
 finish

@@ -319,25 +319,6 @@ static int fail(void)
     return status == FS_OK ? FS_ERR_INTERNAL : status;
 }
 
-/* Reads a whole (small) text file for hashing; NULL if unreadable. */
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 4096, n = 0;
-    char *buf = fs_malloc(cap);
-    size_t got;
-    while ((got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
-        n += got;
-        if (cap - n < 2)
-            buf = fs_realloc(buf, cap *= 2);
-    }
-    fclose(f);
-    buf[n] = '\0';
-    return buf;
-}
-
 /* Loads the preset and applies every override, in the order: file, --set, then dedicated options. */
 static int load_config(const char *arg, const options *o, fs_config *cfg, char **preset_path)
 {
@@ -636,7 +617,8 @@ static int run(const char *preset_arg, const options *o)
         free(preset_path);
         return fail();
     }
-    char *preset_text = read_text(preset_path);
+    char *preset_text = fs_preset_read_text(preset_path);
+    fs_error_clear();
     fs_info("%s: %s model on a %s, %d elements, seed %" PRIu64 ", %dx%d maps", preset_path,
             fs_model_name(cfg.preset.model), fs_domain_type_name(cfg.domain.type), (int)cfg.mesh.elements,
             cfg.preset.seed, cfg.render.width, cfg.render.height);
