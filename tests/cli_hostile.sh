@@ -51,6 +51,49 @@ if mkfifo "$tmp/path/fifo.ini"; then
     grep -q "not a regular file" "$tmp/stderr" && ok "the FIFO named: the message says why" \
         || not_ok "the FIFO named: the message says why"
 fi
+# Input maps: the size in the header is checked before decoding (a valid 30000 x 30000 grey PNG as a
+# threshold map was decoded at 8 GB peak); the decoder's complaint is part of fissure's one-line
+# message (raw "libpng error:" lines came first); special files are refused without blocking.
+printf '\211PNG\r\n\032\n\0\0\0\rIHDR\0\0u0\0\0u0\010\0\0\0\0\0\0\0\0\0\0\0\0IDATx' > "$tmp/huge.png"
+bounded 30 65 "a 30000 x 30000 threshold map: exit 65" "$FISSURE" -q -o "$tmp/map" --size 32x32 \
+    --set mesh.elements=200 --set material.threshold_map="$tmp/huge.png" "$PRESETS/heart.ini"
+grep -q "huge.png: PNG image of 30000 x 30000 pixels: expected at most 67108864 pixels" "$tmp/stderr" \
+    && ok "the message gives the size and the limit" || { not_ok "the message gives the size and the limit"; head -3 "$tmp/stderr"; }
+[ "$(wc -l < "$tmp/stderr")" -eq 1 ] && ok "one line on stderr (nothing decoded)" || not_ok "one line on stderr"
+cp "$top_srcdir/textures/heart.png" "$tmp/broken.png"
+printf '\377\377\377\377' | dd of="$tmp/broken.png" bs=1 seek=200 conv=notrunc 2>/dev/null
+expect_status 65 "a corrupt PNG map: exit 65" "$FISSURE" -q -o "$tmp/map" --size 32x32 --set mesh.elements=200 \
+    --set material.threshold_map="$tmp/broken.png" "$PRESETS/heart.ini"
+grep -q "^fissure: .*broken.png: cannot decode the PNG image: libpng error: " "$tmp/stderr" \
+    && ok "the decoder's complaint is in fissure's message" || { not_ok "the decoder's complaint is in fissure's message"; head -3 "$tmp/stderr"; }
+grep -v -q '^fissure: ' "$tmp/stderr" && not_ok "no raw decoder line on stderr" || ok "no raw decoder line on stderr"
+if mkfifo "$tmp/map.png"; then
+    bounded 10 66 "a FIFO as a map: exit 66" "$FISSURE" -q -o "$tmp/map" --size 32x32 --set mesh.elements=200 \
+        --set material.threshold_map="$tmp/map.png" "$PRESETS/heart.ini"
+fi
+[ ! -e "$tmp/map" ] && ok "bad maps write nothing" || not_ok "bad maps write nothing"
+
+# A full disk (a small tmpfs, where a mount namespace can be had): exit 74 with the system's reason,
+# and nothing left (libpng printed "libpng error: Write Error" and fissure gave no reason).
+if unshare -rm true 2>/dev/null || unshare -m true 2>/dev/null; then
+    u=-m; unshare -m true 2>/dev/null || u=-rm
+    for size in 16k 60k; do
+        mkdir -p "$tmp/full"
+        unshare $u sh -c 'mount -t tmpfs -o size="$1" tmpfs "$2" || exit 99; shift 2; "$@"; s=$?; ls -A "$0/o" > "$0.left" 2>/dev/null; exit $s' \
+            "$tmp/full" "$size" "$tmp/full" "$FISSURE" -q -o "$tmp/full/o" --size 128x128 --set mesh.elements=300 \
+            "$PRESETS/voronoi-tile.ini" >/dev/null 2>"$tmp/stderr"
+        status=$?
+        if [ "$status" -eq 99 ]; then ok "full disk: no tmpfs here (skipped)"; break; fi
+        [ "$status" -eq 74 ] && ok "a full disk ($size): exit 74" || not_ok "a full disk ($size): exit status $status"
+        grep -q "^fissure: .*: cannot write .*: No space left on device$" "$tmp/stderr" && ok "the message says why" \
+            || { not_ok "the message says why"; head -3 "$tmp/stderr"; }
+        grep -v -q '^fissure: ' "$tmp/stderr" && not_ok "no raw library line" || ok "no raw library line"
+        [ ! -s "$tmp/full.left" ] && ok "nothing left in the output directory" || not_ok "files left: $(cat "$tmp/full.left")"
+    done
+else
+    ok "full disk: no mount namespace here (skipped)"
+fi
+
 # The preset size limit (1 MiB, fissure-preset(5)).
 awk 'BEGIN { printf "#"; for (i = 0; i < 1048576; i++) printf "a"; print "" }' > "$tmp/big.ini"
 expect_status 65 "a preset over 1 MiB: exit 65" "$FISSURE" --dump-preset "$tmp/big.ini"

@@ -3,6 +3,7 @@
 
 #include "config.h"
 
+#include <errno.h>
 #include <jansson.h>
 #include <stdbool.h>
 #include <string.h>
@@ -170,10 +171,12 @@ int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_
     }
     json_object_set_new(root, "files", jfiles);
 
+    errno = 0;
     int rc = json_dump_file(root, path, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10));
+    int err = errno;
     json_decref(root);
     if (rc != 0) {
-        fs_error(FS_ERR_IO, "%s: cannot write the sidecar", path);
+        fs_error(FS_ERR_IO, "%s: cannot write the sidecar: %s", path, strerror(err ? err : EIO));
         return -1;
     }
     return 0;
