@@ -342,17 +342,26 @@ static int load_config(const char *arg, const options *o, fs_config *cfg, char *
     return fs_preset_validate(cfg, *preset_path);
 }
 
-/* Lifts the result into 3-D and stages it as OBJ in the directory of path, which may lie outside
- * the output directory. Returns the staged output set, or NULL with fs_error. */
-static fs_output *stage_mesh(const char *path, const fs_config *cfg, const fs_result *res, const char *name)
+/* The directory of a file path (malloc'd: "." for a bare name, "/" at the root), and in *file the
+ * file name in it. */
+static char *dir_of(const char *path, const char **file)
 {
     char *dir = fs_strdup(path);
     char *slash = strrchr(dir, '/');
-    const char *file = slash ? path + (slash - dir) + 1 : path;
+    *file = slash ? path + (slash - dir) + 1 : path;
     if (!slash)
         strcpy(dir, ".");
     else
         slash[slash == dir ? 1 : 0] = '\0';
+    return dir;
+}
+
+/* Lifts the result into 3-D and stages it as OBJ in the directory of path, which may lie outside
+ * the output directory. Returns the staged output set, or NULL with fs_error. */
+static fs_output *stage_mesh(const char *path, const fs_config *cfg, const fs_result *res, const char *name)
+{
+    const char *file;
+    char *dir = dir_of(path, &file);
     fs_output *out = fs_output_begin(dir);
     free(dir);
     if (!out)
@@ -382,13 +391,8 @@ static int check_outputs(const options *o, const char *name)
         return -1;
     if (!o->mesh_path)
         return 0;
-    char *dir = fs_strdup(o->mesh_path);
-    char *slash = strrchr(dir, '/');
-    const char *file = slash ? o->mesh_path + (slash - dir) + 1 : o->mesh_path;
-    if (!slash)
-        strcpy(dir, ".");
-    else
-        slash[slash == dir ? 1 : 0] = '\0';
+    const char *file;
+    char *dir = dir_of(o->mesh_path, &file);
     int rc = fs_output_check(dir, strlen(file) + 1 + 5 + 20 + 1 + 20);
     free(dir);
     return rc;

@@ -147,8 +147,7 @@ int fs_output_check(const char *dir, size_t longest_name)
     }
     int rc = 0;
     if (!S_ISDIR(st.st_mode)) {
-        fs_error(FS_ERR_CANTCREAT, "%s: output path is not a directory%s%s%s", dir, strcmp(path, dir) ? " (" : "",
-                 strcmp(path, dir) ? path : "", strcmp(path, dir) ? " is a file)" : "");
+        fs_error(FS_ERR_CANTCREAT, "%s: output path is not a directory", path);
         rc = -1;
     } else if (access(path, W_OK | X_OK) != 0) {
         fs_error(FS_ERR_CANTCREAT, "%s: output directory is not writable: %s", path, strerror(errno));
