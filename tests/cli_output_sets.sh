@@ -67,6 +67,15 @@ for sig in TERM INT HUP; do
     [ "$status" -gt 128 ] && ok "SIG$sig ends the run by the signal" || not_ok "SIG$sig: exit status $status"
 done
 
+# The file size limit: SIGXFSZ is blocked, so the write fails with a reason and the run cleans up.
+(ulimit -f 20; exec "$FISSURE" -q -o "$tmp/fsize" --size 256x256 --set mesh.elements=300 \
+    "$PRESETS/voronoi-tile.ini") >/dev/null 2>"$tmp/stderr"
+status=$?
+[ "$status" -eq 74 ] && grep -q "cannot write image: File too large" "$tmp/stderr" \
+    && ok "past the file size limit: exit 74, File too large" || { not_ok "past the file size limit: exit status $status"; head -2 "$tmp/stderr"; }
+[ -z "$(ls -A "$tmp/fsize" 2>/dev/null)" ] && ok "past the file size limit: nothing left" \
+    || not_ok "past the file size limit: files left"
+
 # ---- a failed commit leaves nothing of its run and no sidecar beside another run's files ----
 d="$tmp/fail"
 "$FISSURE" -q -o "$d" -n s -s 1 $small "$PRESETS/mud.ini" >/dev/null 2>&1

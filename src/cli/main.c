@@ -682,6 +682,9 @@ __attribute__((section(".preinit_array"), used)) static void (*const preinit_blo
 
 int main(int argc, char **argv)
 {
+    /* every mode: the termination signals are blocked from the preinit array on, and taken here */
+    if (fs_output_cleanup_on_signals() < 0)
+        return fail();
     if (argc > 1 && !strcmp(argv[1], "diff"))
         return fs_cli_diff(argc - 1, argv + 1);
 
@@ -700,10 +703,6 @@ int main(int argc, char **argv)
     if (optind != argc - 1) {
         free(o.sets);
         return usage_error("%s", optind >= argc ? "missing PRESET argument" : "expected exactly one PRESET argument");
-    }
-    if (fs_output_cleanup_on_signals() < 0) {
-        free(o.sets);
-        return fail();
     }
     rc = run(argv[optind], &o);
     free(o.sets);

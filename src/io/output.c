@@ -433,10 +433,11 @@ void fs_output_abort(fs_output *o)
  * are blocked in the main thread before any library starts a thread (fs_output_block_signals, called
  * from the program's preinit array), so every thread inherits the mask, and sigwait returns them
  * here. The waiting thread removes what the live sets have put down, reading them with the
- * lock-free protocol above, then ends the process by the signal. SIGPIPE and SIGXFSZ, sent to the
- * thread that writes, stay blocked there: the write fails (EPIPE, EFBIG) and the error path cleans
- * up. */
-static const int cleanup_signals[] = {SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGPIPE, SIGXCPU, SIGXFSZ};
+ * lock-free protocol above, then ends the process by the signal. SIGXFSZ, sent to the thread that
+ * writes past the file size limit, stays blocked there: the write fails (EFBIG) and the error path
+ * cleans up. SIGPIPE keeps its default: a reader that goes away (fissure --list-presets | head -1)
+ * ends fissure quietly, and stdout is written only once the set is in place. */
+static const int cleanup_signals[] = {SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGXCPU, SIGXFSZ};
 #define N_CLEANUP_SIGNALS ((int)(sizeof cleanup_signals / sizeof cleanup_signals[0]))
 
 static sigset_t blocked;

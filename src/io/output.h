@@ -49,15 +49,15 @@ int fs_output_commit(fs_output *o);
 /* Removes every staged temporary file and frees o. */
 void fs_output_abort(fs_output *o);
 
-/* Blocks SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGPIPE, SIGXCPU and SIGXFSZ (those not ignored) in the
+/* Blocks SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGXCPU and SIGXFSZ (those not ignored) in the
  * calling thread. The program calls it before any thread starts (from its preinit array, before
  * the libraries' constructors start theirs), so that every thread inherits the mask. */
 void fs_output_block_signals(void);
 
 /* Starts the thread that waits for those signals: on one it removes the temporary files of every
  * output set not yet committed, and the files a commit in progress has moved into place, then
- * ends the process by the same signal. SIGPIPE and SIGXFSZ make the write that caused them fail
- * instead. SIGKILL cannot be caught: a killed run may leave its temporary files (fissure(1) says
+ * ends the process by the same signal. SIGXFSZ makes the write that caused it fail instead.
+ * SIGKILL cannot be caught: a killed run may leave its temporary files (fissure(1) says
  * what a reader makes of the rest). Returns 0, or -1 with fs_error (the signals then keep their
  * default action). */
 int fs_output_cleanup_on_signals(void);
