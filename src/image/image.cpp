@@ -220,10 +220,9 @@ static int read_bytes(const char *path, std::vector<unsigned char> *bytes)
         return -1;
     }
     struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        int err = errno;
-        fs_error(FS_ERR_NOINPUT, "%s: cannot open image: %s", path,
-                 S_ISDIR(st.st_mode) ? strerror(EISDIR) : !S_ISREG(st.st_mode) ? "not a regular file" : strerror(err));
+    int status = fstat(fd, &st) != 0 ? errno : S_ISDIR(st.st_mode) ? EISDIR : 0;
+    if (status != 0 || !S_ISREG(st.st_mode)) {
+        fs_error(FS_ERR_NOINPUT, "%s: cannot open image: %s", path, status ? strerror(status) : "not a regular file");
         close(fd);
         return -1;
     }
