@@ -39,6 +39,13 @@ fs_json *fs_json_string(const char *s)
     return wrap(v ? v : json_null());
 }
 
+bool fs_json_valid_utf8(const char *s)
+{
+    json_t *v = s ? json_string(s) : NULL;
+    json_decref(v);
+    return v != NULL;
+}
+
 fs_json *fs_json_real(double v)
 {
     return wrap(isfinite(v) ? json_real(v) : json_null());

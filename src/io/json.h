@@ -15,6 +15,7 @@ typedef struct fs_json fs_json;
 fs_json *fs_json_object(void);
 fs_json *fs_json_array(void);
 fs_json *fs_json_string(const char *s); /* UTF-8; NULL or invalid UTF-8 gives null */
+bool fs_json_valid_utf8(const char *s);  /* whether fs_json_string keeps s */
 fs_json *fs_json_integer(int64_t v);
 fs_json *fs_json_real(double v);        /* a non-finite v gives null (JSON has no such number) */
 fs_json *fs_json_bool(bool v);
@@ -39,7 +40,7 @@ typedef struct {
 } fs_json_format;
 
 /* Writes root to exactly path (not atomic by itself: io/output.h stages files). Returns 0, or -1
- * without fs_error: the caller names the file it was writing. */
+ * without fs_error, errno saying why: the caller names the file it was writing. */
 int fs_json_write(const fs_json *root, const char *path, fs_json_format fmt);
 
 /* The document as a NUL-terminated string (caller frees), or NULL when out of memory. */
