@@ -79,6 +79,27 @@ size_t fs_json_size(const fs_json *v)
     return json_is_array(j) ? json_array_size(j) : json_is_object(j) ? json_object_size(j) : 0;
 }
 
+fs_json *fs_json_at(fs_json *array, size_t i)
+{
+    return (fs_json *)json_array_get(unwrap(array), i);
+}
+
+const char *fs_json_text(const fs_json *v)
+{
+    return json_string_value(unwrap(v));
+}
+
+double fs_json_number(const fs_json *v)
+{
+    json_t *j = unwrap(v);
+    return json_is_number(j) ? json_number_value(j) : NAN;
+}
+
+fs_json *fs_json_read(const char *path)
+{
+    return (fs_json *)json_load_file(path, 0, NULL);
+}
+
 static size_t flags(fs_json_format fmt)
 {
     size_t f = JSON_PRESERVE_ORDER | JSON_INDENT(fmt.indent < 0 ? 0 : fmt.indent > 31 ? 31 : fmt.indent);

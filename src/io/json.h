@@ -32,6 +32,13 @@ void fs_json_append(fs_json *array, fs_json *value);
 /* Number of elements of an array or keys of an object. */
 size_t fs_json_size(const fs_json *v);
 
+/* Reading back a document (tests and tools check what was written): array[i] (borrowed, NULL out
+ * of range), a string's text (NULL when v is not a string), a number's value (NaN when v is not a
+ * number). */
+fs_json *fs_json_at(fs_json *array, size_t i);
+const char *fs_json_text(const fs_json *v);
+double fs_json_number(const fs_json *v);
+
 /* Formatting of a written document: indent spaces per level (0: one line), and the significant
  * digits of reals (0: as many as make the double read back exactly). */
 typedef struct {
@@ -45,6 +52,9 @@ int fs_json_write(const fs_json *root, const char *path, fs_json_format fmt);
 
 /* The document as a NUL-terminated string (caller frees), or NULL when out of memory. */
 char *fs_json_dump(const fs_json *root, fs_json_format fmt);
+
+/* Parses the JSON file at path; NULL when it cannot be read or is not JSON (the caller reports). */
+fs_json *fs_json_read(const char *path);
 
 void fs_json_free(fs_json *v);
 
