@@ -228,19 +228,10 @@ static int32_t tets_of(fs_tet *s, const int32_t *nodes, int32_t n, int32_t **out
 /* The forces of every load's current displacements in tetrahedron t: f[12 * k + ...]. */
 static void element_forces(const fs_tet *s, int32_t t, double *f)
 {
-    const int32_t *v = s->mesh.tet + 4 * (size_t)t;
-    const double *g = s->grad + 12 * (size_t)t;
-    int nl = s->n_loads;
-    for (int k = 0; k < nl; k++) {
-        double u[12], eps[6], sigma[6];
-        for (int c = 0; c < 4; c++)
-            memcpy(u + 3 * c, s->u + 3 * ((size_t)nl * v[c] + k), 3 * sizeof *u);
-        fs_tet_strain(g, u, eps);
-        const double *e0 = s->eps0 + 6 * ((size_t)nl * t + k);
-        for (int q = 0; q < 6; q++)
-            eps[q] -= e0[q];
-        fs_tet_stress(s->lambda[t], s->mu[t], eps, sigma);
-        fs_tet_forces(g, s->vol[t], sigma, f + 12 * k);
+    for (int k = 0; k < s->n_loads; k++) {
+        double sigma[6];
+        fs_tet_load_stress(s, t, k, sigma);
+        fs_tet_forces(s->grad + 12 * (size_t)t, s->vol[t], sigma, f + 12 * k);
     }
 }
 

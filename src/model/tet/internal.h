@@ -122,6 +122,9 @@ void fs_tet_load_eigenstrain(const fs_tet *s, int k, int32_t t, double eps0[6]);
  * tetrahedron without volume. */
 int fs_tet_update_geometry(fs_tet *s, int32_t t);
 
+/* The stress (Voigt) of load case k's displacements in tetrahedron t, its eigenstrain taken off. */
+void fs_tet_load_stress(const fs_tet *s, int32_t t, int k, double sigma[6]);
+
 /* The stresses of every load in tetrahedron t from the current displacements. */
 void fs_tet_update_stress(fs_tet *s, int32_t t);
 

@@ -261,21 +261,25 @@ static void prescribed(const fs_tet *s, int k, int32_t i, double out[3])
         out[a] = l->move[3 * a] * d[0] + l->move[3 * a + 1] * d[1] + l->move[3 * a + 2] * d[2];
 }
 
-void fs_tet_update_stress(fs_tet *s, int32_t t)
+void fs_tet_load_stress(const fs_tet *s, int32_t t, int k, double sigma[6])
 {
     const int32_t *v = s->mesh.tet + 4 * (size_t)t;
-    const double *g = s->grad + 12 * (size_t)t;
     int nl = s->n_loads;
-    for (int k = 0; k < nl; k++) {
-        double u[12], eps[6];
-        for (int c = 0; c < 4; c++)
-            memcpy(u + 3 * c, s->u + 3 * ((size_t)nl * v[c] + k), 3 * sizeof *u);
-        fs_tet_strain(g, u, eps);
-        const double *e0 = s->eps0 + 6 * ((size_t)nl * t + k);
-        for (int q = 0; q < 6; q++)
-            eps[q] -= e0[q];
-        fs_tet_stress(s->lambda[t], s->mu[t], eps, s->stress + 6 * ((size_t)nl * t + k));
-    }
+    double u[12], eps[6];
+    for (int c = 0; c < 4; c++)
+        memcpy(u + 3 * c, s->u + 3 * ((size_t)nl * v[c] + k), 3 * sizeof *u);
+    fs_tet_strain(s->grad + 12 * (size_t)t, u, eps);
+    const double *e0 = s->eps0 + 6 * ((size_t)nl * t + k);
+    for (int q = 0; q < 6; q++)
+        eps[q] -= e0[q];
+    fs_tet_stress(s->lambda[t], s->mu[t], eps, sigma);
+}
+
+void fs_tet_update_stress(fs_tet *s, int32_t t)
+{
+    int nl = s->n_loads;
+    for (int k = 0; k < nl; k++)
+        fs_tet_load_stress(s, t, k, s->stress + 6 * ((size_t)nl * t + k));
     if (s->proportional) {
         double *ref = s->split_ref + 12 * (size_t)t;
         fs_tet_stress_at(s, t, s->c_ref, ref);

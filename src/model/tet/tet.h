@@ -23,7 +23,7 @@ typedef struct {
                               loose); 0: no limit */
 } fs_tet_params;
 
-/* layers 0 (automatic), snap distance 0.1 edge lengths, snap angle 5.73 degrees (0.1 rad, the
+/* layers 0 (automatic), snap distance 0.3 edge lengths, snap angle 5.73 degrees (0.1 rad, the
  * paper's), bond 0 (never comes loose), no event limit. */
 fs_tet_params fs_tet_params_default(void);
 
