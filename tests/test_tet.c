@@ -406,6 +406,62 @@ static void check_solid_closed(const fs_tet *s)
     fs_solid_free(&solid);
 }
 
+/* Whether a boundary face with corners v is inside the strip of test_strip_breaks_across (not its
+ * top, bottom or sides): a crack wall. */
+static bool strip_inside(const fs_tet *s, const int32_t v[3])
+{
+    int inside = 0;
+    for (int k = 0; k < 3; k++) {
+        const double *p = s->mesh.pos + 3 * (size_t)v[k];
+        inside += s->mesh.zeta[v[k]] > 0.0 && s->mesh.zeta[v[k]] < 1.0 && p[0] > 0.0 && p[0] < 6.0 && p[1] > 0.0 &&
+                  p[1] < 2.0;
+    }
+    return inside > 0;
+}
+
+/* Whether a boundary face with corners v is neither on the layer's top nor on its bottom (on a domain
+ * without sides: a crack wall). */
+static bool off_top_and_bottom(const fs_tet *s, const int32_t v[3])
+{
+    return !(s->mesh.zeta[v[0]] == s->mesh.zeta[v[1]] && s->mesh.zeta[v[1]] == s->mesh.zeta[v[2]]);
+}
+
+/* The mean orientation of the crack walls (the boundary faces is_wall accepts): the principal axis
+ * of the area-weighted sum of n n^T over them, into dir; false when there are none. */
+static bool wall_direction(const fs_tet *s, bool (*is_wall)(const fs_tet *, const int32_t[3]), double dir[3])
+{
+    int32_t *adj = malloc((4 * (size_t)s->mesh.n_tets + 1) * sizeof *adj);
+    fs_tetmesh_adjacency(&s->mesh, adj);
+    double nn[9] = {0}, area = 0.0;
+    for (int32_t h = 0; h < 4 * s->mesh.n_tets; h++) {
+        if (adj[h] >= 0)
+            continue;
+        const int *f = fs_tet_face[h % 4];
+        int32_t v[3];
+        for (int k = 0; k < 3; k++)
+            v[k] = s->mesh.tet[4 * (size_t)(h / 4) + f[k]];
+        if (!is_wall(s, v))
+            continue;
+        double x[12], e1[3], e2[3], n[3];
+        fs_tetmesh_corners(&s->mesh, h / 4, x);
+        fs_sub3(e1, x + 3 * f[1], x + 3 * f[0]);
+        fs_sub3(e2, x + 3 * f[2], x + 3 * f[0]);
+        fs_cross3(n, e1, e2);
+        double a = fs_norm3(n);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                nn[3 * i + j] += n[i] * n[j] / a;
+        area += a;
+    }
+    free(adj);
+    if (!(area > 0.0))
+        return false;
+    double val[3], vec[9];
+    fs_eigen_sym3(nn, val, vec);
+    memcpy(dir, vec, 3 * sizeof *dir);
+    return true;
+}
+
 /* A strip bonded to a substrate stretched along x breaks across the stretch: the walls of its cracks
  * face along x (their mean orientation, the principal axis of the area-weighted sum of n n^T, within 5
  * degrees: single faces zigzag where the cut snapped to existing nodes). */
@@ -440,42 +496,57 @@ static void test_strip_breaks_across(void)
     }
     CHECK(fs_tet_advance(s, 1.0) == 0);
     CHECK(s->counters.splits > 10);
-    int32_t *adj = malloc((4 * (size_t)s->mesh.n_tets + 1) * sizeof *adj);
-    fs_tetmesh_adjacency(&s->mesh, adj);
-    double nn[9] = {0}, area = 0.0;
-    for (int32_t h = 0; h < 4 * s->mesh.n_tets; h++) {
-        if (adj[h] >= 0)
-            continue;
-        const int *f = fs_tet_face[h % 4];
-        int inside = 0;
-        for (int k = 0; k < 3; k++) {
-            int32_t v = s->mesh.tet[4 * (size_t)(h / 4) + f[k]];
-            const double *p = s->mesh.pos + 3 * (size_t)v;
-            inside += s->mesh.zeta[v] > 0.0 && s->mesh.zeta[v] < 1.0 && p[0] > 0.0 && p[0] < 6.0 && p[1] > 0.0 &&
-                      p[1] < 2.0;
-        }
-        if (inside == 0)
-            continue; /* top, bottom and the strip's sides */
-        double x[12], e1[3], e2[3], n[3];
-        fs_tetmesh_corners(&s->mesh, h / 4, x);
-        fs_sub3(e1, x + 3 * f[1], x + 3 * f[0]);
-        fs_sub3(e2, x + 3 * f[2], x + 3 * f[0]);
-        fs_cross3(n, e1, e2);
-        double a = fs_norm3(n);
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++)
-                nn[3 * i + j] += n[i] * n[j] / a;
-        area += a;
-    }
-    free(adj);
-    CHECK(area > 0.0);
-    double val[3], vec[9];
-    fs_eigen_sym3(nn, val, vec);
+    double vec[3];
+    CHECK(wall_direction(s, strip_inside, vec));
     double angle = acos(fmin(fabs(vec[0]), 1.0)) * 180.0 / FS_PI;
     printf("strip: %lld splits, crack walls %.2f degrees off the stretch's normal plane on average\n",
            (long long)s->counters.splits, angle);
     CHECK(angle < 5.0);
     check_solid_closed(s);
+    fs_tet_destroy(s);
+    fs_mesh_free(&mesh);
+}
+
+/* Bark: a layer on a trunk that grows in girth only (cylinder growth, periodic along the axis) is
+ * stretched around the trunk, so it splits along the axis: the crack walls face around the trunk (x
+ * in the unrolled layer), their mean orientation within 20 degrees of it. */
+static void test_bark_cracks_along_axis(void)
+{
+    fs_domain d = fs_domain_default();
+    d.type = FS_DOMAIN_CYLINDER;
+    d.radius = 1.0;
+    d.height = 6.0;
+    d.periodic_y = true;
+    fs_domain_normalize(&d);
+    fs_sample_params sp = fs_sample_params_default();
+    sp.count = 300;
+    sp.seed = 5;
+    fs_points pts = {0};
+    fs_mesh mesh = {0};
+    CHECK(fs_sample_repulsion(&d, &sp, &pts) == 0 && fs_delaunay(&d, &pts, &mesh) == 0);
+    fs_points_free(&pts);
+    fs_model_setup cfg = setup_for(10.0, 0.3);
+    cfg.seed = 6;
+    cfg.material.threshold = 50.0;
+    cfg.material.thickness = 0.3;
+    cfg.growth.type = FS_GROWTH_CYLINDER;
+    cfg.growth.rate = 0.02;
+    cfg.time.min_step = 1e-3;
+    cfg.tet.max_events = 40;
+    fs_tet *s = fs_tet_create(&mesh, &cfg);
+    CHECK(s != NULL);
+    if (!s) {
+        fs_mesh_free(&mesh);
+        return;
+    }
+    CHECK(fs_tet_advance(s, 1.0) == 0);
+    CHECK(s->counters.splits > 10);
+    double vec[3];
+    CHECK(wall_direction(s, off_top_and_bottom, vec));
+    double angle = acos(fmin(fabs(vec[0]), 1.0)) * 180.0 / FS_PI;
+    printf("bark: %lld splits, crack walls %.2f degrees off the plane across the trunk's circumference\n",
+           (long long)s->counters.splits, angle);
+    CHECK(angle < 20.0);
     fs_tet_destroy(s);
     fs_mesh_free(&mesh);
 }
@@ -488,5 +559,6 @@ int main(void)
     RUN(test_bonded_layer);
     RUN(test_bilayer);
     RUN(test_strip_breaks_across);
+    RUN(test_bark_cracks_along_axis);
     return check_finish();
 }
