@@ -319,7 +319,7 @@ static void test_errors(void)
     static const error_case cases[] = {
         {"[preset]\nname = a\n[colour]\nx = 1\n",
          "t.ini:3: unknown section [colour]: expected one of: preset, domain, mesh, material, growth, shrink, "
-         "fracture, time, render, voronoi, solver, wedge, springs"},
+         "fracture, time, render, voronoi, solver, wedge, springs, shell"},
         {"[mesh]\n\nelement = 100\n",
          "t.ini:3: unknown key [mesh] element: expected one of: elements, min_size, lattice, relax_iterations, "
          "radius_jitter, refine_vm, refine_vm_rounds, smooth_radius, smooth_iterations"},
@@ -441,7 +441,7 @@ static void test_set(void)
         {"a.b.c=5", FS_ERR_USAGE, "--set: expected SECTION.KEY=VALUE, got 'a.b.c=5'"},
         {"meshes.elements=5", FS_ERR_USAGE,
          "--set meshes.elements: unknown section [meshes]: expected one of: preset, domain, mesh, material, growth, "
-         "shrink, fracture, time, render, voronoi, solver, wedge, springs"},
+         "shrink, fracture, time, render, voronoi, solver, wedge, springs, shell"},
         {"time.stop=5", FS_ERR_USAGE, "--set time.stop: unknown key [time] stop: expected one of: end, min_step"},
         {"mesh.elements=lots", FS_ERR_DATA, "--set mesh.elements: expected an integer in 16..20000000, got 'lots'"},
         {"render.normal=up", FS_ERR_DATA, "--set render.normal: expected opengl or directx, got 'up'"},

@@ -59,7 +59,7 @@ typedef struct {
 
 static const char *const section_names[] = {"preset", "domain", "mesh", "material", "growth",
                                             "shrink", "fracture", "time", "render", "voronoi", "solver",
-                                            "wedge", "springs", NULL};
+                                            "wedge", "springs", "shell", NULL};
 static const char *const model_words[] = {"voronoi", "springs", "wedge", "shell", "tet", NULL};
 static const char *const domain_words[] = {"plane", "cylinder", "sphere", NULL};
 static const char *const periodic_words[] = {"none", "x", "y", "xy", NULL};
@@ -162,6 +162,13 @@ static const key_def key_table[] = {
     {"springs", "max_breaks", KEY_INT, OFF(springs.max_breaks), 0, 2000000000, GE | LE, NULL, NULL},
     {"springs", "post", KEY_WORD, OFF(springs.post), 0, 0, 0, post_words, NULL},
     {"springs", "peel", KEY_REAL, OFF(springs.peel), 0, 0, GE, NULL, "cm"},
+
+    {"shell", "bond", KEY_REAL, OFF(shell.bond), 0, 1e6, GE | LE, NULL, NULL},
+    {"shell", "yield", KEY_REAL, OFF(shell.yield), 0, 0, GE, NULL, "kPa"},
+    {"shell", "hardening", KEY_REAL, OFF(shell.hardening), 0, 0, GE, NULL, NULL},
+    {"shell", "budge", KEY_REAL, OFF(shell.budge), 0, 0.45, GE | LE, NULL, NULL},
+    {"shell", "gap_scale", KEY_REAL, OFF(shell.gap_scale), 1, 1e6, GE | LE, NULL, NULL},
+    {"shell", "max_step", KEY_REAL, OFF(shell.max_step), 0, 1, GT | LE, NULL, NULL},
 };
 
 #define N_KEYS ((int)(sizeof key_table / sizeof key_table[0]))

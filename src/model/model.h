@@ -9,6 +9,7 @@
 #include "geom/mesh.h"
 #include "geom/surface.h"
 #include "model/params.h"
+#include "model/shell/shell.h"
 #include "model/springs/springs.h"
 #include "model/voronoi.h"
 #include "model/wedge/wedge.h"
@@ -78,6 +79,10 @@ struct fs_model_setup {
     fs_voronoi_params voronoi;
     fs_springs_params springs;
     fs_wedge_params wedge;
+    fs_shell_params shell;
+    const double *corner_uv;      /* mesh domain: 6 per triangle of the mesh given to fs_model_init, the
+                                     texture coordinates of its corners (the UV layout the maps are
+                                     rendered into; borrowed); NULL on the other domains */
 };
 typedef struct fs_model_setup fs_model_setup;
 
@@ -92,6 +97,7 @@ typedef struct {
     union {
         fs_springs *springs;
         fs_wedge_model *wedge;
+        fs_shell *shell;
     } state;                      /* the kind's state; voronoi has none */
 } fs_model;
 

@@ -23,6 +23,7 @@ fs_config fs_config_default(void)
     c.springs = fs_springs_params_default();
     c.solver = fs_solver_params_default();
     c.wedge = fs_wedge_params_default();
+    c.shell = fs_shell_params_default();
     return c;
 }
 
@@ -41,5 +42,6 @@ fs_model_setup fs_config_model_setup(const fs_config *cfg)
     s.voronoi = cfg->voronoi;
     s.springs = cfg->springs;
     s.wedge = cfg->wedge;
+    s.shell = cfg->shell;
     return s;
 }

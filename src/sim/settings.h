@@ -43,6 +43,7 @@ typedef struct {
     fs_springs_params springs;
     fs_solver_params solver;
     fs_wedge_params wedge;
+    fs_shell_params shell;
 } fs_config;
 
 /* Every section at its default: a 10 x 10 cm non-periodic plane, voronoi model, 1000 elements. */
