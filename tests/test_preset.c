@@ -330,7 +330,7 @@ static void test_errors(void)
         {"[material]\nthickness_final = 0\n",
          "t.ini:2: [material] thickness_final: expected none or a number > 0 (cm), got '0'"},
         {"[domain]\nwidth = 2e6\n", "t.ini:2: [domain] width: expected a number in (0, 1e+06] (cm), got '2e6'"},
-        {"[domain]\ntype = torus\n", "t.ini:2: [domain] type: expected plane, cylinder or sphere, got 'torus'"},
+        {"[domain]\ntype = torus\n", "t.ini:2: [domain] type: expected plane, cylinder, sphere or mesh, got 'torus'"},
         {"[domain]\nperiodic = z\n", "t.ini:2: [domain] periodic: expected none, x, y or xy, got 'z'"},
         {"[mesh]\nelements = 1000.5\n", "t.ini:2: [mesh] elements: expected an integer in 16..20000000, got '1000.5'"},
         {"[mesh]\nelements = 8\n", "t.ini:2: [mesh] elements: expected an integer in 16..20000000, got '8'"},

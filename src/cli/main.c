@@ -331,7 +331,7 @@ static fs_output *stage_mesh(const char *path, const fs_config *cfg, const fs_re
     if (!out)
         return NULL;
     fs_lifted_mesh lifted;
-    int rc = fs_render_lift(&res->surface, &cfg->domain, 1.0, &lifted);
+    int rc = fs_render_lift(&res->surface, &res->mesh.domain, 1.0, &lifted);
     if (rc == 0) {
         char comment[200];
         snprintf(comment, sizeof comment, "fissure %s: preset %s, seed %" PRIu64 ", %s model on a %s", PACKAGE_VERSION,
@@ -424,8 +424,8 @@ static int write_frame(void *ctx, int32_t k, int32_t count, double t, const fs_s
     int rc = fs_render_raster(surface, cfg->render.width, cfg->render.height, cfg->render.supersample, wu, wv,
                               &raster);
     if (rc == 0)
-        rc = fs_maps_build(&raster, &cfg->render, wu, wv, fs_domain_extent_x(&d) / cfg->render.width,
-                           fs_domain_extent_y(&d) / cfg->render.height, &maps);
+        rc = fs_maps_build(&raster, &cfg->render, wu, wv, stats->extent_u / cfg->render.width,
+                           stats->extent_v / cfg->render.height, &maps);
     char stem[560];
     snprintf(stem, sizeof stem, "%s_frame_%04d", fw->name, (int)k);
     fs_target_inputs in = {.maps = &maps, .height = &maps.height, .height_ext = "png", .normal = cfg->render.normal};
@@ -589,8 +589,7 @@ static int run(const char *preset_arg, const options *o)
     fs_sim_frames frames = {o->frames, write_frame, &fw};
     int rc = fs_sim_run_frames(&cfg, o->frames > 0 ? &frames : NULL, &res);
     if (rc == 0) {
-        fs_domain d = cfg.domain;
-        fs_domain_normalize(&d);
+        fs_domain d = res.mesh.domain; /* a mesh domain's texture size is known once it is read */
         bool wu = fs_domain_wraps_u(&d), wv = fs_domain_wraps_v(&d);
         fs_progress("render", -1, "%dx%d, %d triangles", cfg.render.width, cfg.render.height,
                     (int)res.surface.n_tris);

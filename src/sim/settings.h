@@ -31,6 +31,8 @@ typedef struct {
 typedef struct {
     fs_preset_info preset;
     fs_domain domain;
+    char domain_file[FS_PATH_MAX]; /* [domain] file: the UV-mapped OBJ of a mesh domain, resolved against
+                                      the preset's directory; "" for none */
     fs_mesh_params mesh;
     fs_material material;
     fs_material_files material_files;

@@ -85,6 +85,9 @@ struct fs_shell {
     double *node_area;             /* per node: a third of the rest area of its triangles (cm^2) */
     uint8_t *pin;                  /* per node: bit k set when component k is held at x (tests) */
     double *f_ext;                 /* 3 per node: dead load (MPa cm^2), all 0 unless a test sets it */
+    int32_t *origin;               /* per node: the node it was duplicated from by a crack (itself if
+                                      none), so the two walls of a crack are the boundary edges with
+                                      the same pair of origins */
     double bond_t, bond_n;         /* bond stiffness per unit area, tangential and normal (MPa / cm) at
                                       the base thickness and Young's modulus */
 

@@ -101,6 +101,7 @@ static void reserve_nodes(fs_shell *s, int32_t n)
     GROW(node_area, 1);
     GROW(pin, 1);
     GROW(f_ext, 3);
+    GROW(origin, 1);
     GROW(grad, 3);
     GROW(dof, 3);
     s->cap_nodes = cap;
@@ -296,13 +297,25 @@ fs_shell *fs_shell_build(fs_mesh *mesh, const fs_model_setup *setup)
         if (d->type == FS_DOMAIN_PLANE) {
             double *r = s->rest + 3 * (size_t)i;
             r[0] = p[0], r[1] = p[1], r[2] = 0.0;
+        } else if (d->type == FS_DOMAIN_MESH) {
+            memcpy(s->rest + 3 * (size_t)i, p, 3 * sizeof *p);
         } else {
             fs_domain_embed(d, p, s->rest + 3 * (size_t)i);
         }
     }
     memcpy(s->x, s->rest, 3 * (size_t)s->n_nodes * sizeof *s->x);
+    for (int32_t i = 0; i < s->n_nodes; i++)
+        s->origin[i] = i;
+    if (d->type == FS_DOMAIN_MESH && !setup->corner_uv) {
+        fs_error(FS_ERR_DATA, "shell: a mesh domain without texture coordinates");
+        fs_shell_destroy(s);
+        return NULL;
+    }
     for (int32_t t = 0; t < s->n_tris; t++) {
-        domain_uv(s, t, s->uv + 6 * (size_t)t);
+        if (d->type == FS_DOMAIN_MESH)
+            memcpy(s->uv + 6 * (size_t)t, setup->corner_uv + 6 * (size_t)t, 6 * sizeof *s->uv);
+        else
+            domain_uv(s, t, s->uv + 6 * (size_t)t);
         tri_materials(s, t);
     }
     if (fs_shell_rest_geometry(s) < 0) {
@@ -383,6 +396,7 @@ void fs_shell_destroy(fs_shell *s)
     free(s->node_area);
     free(s->pin);
     free(s->f_ext);
+    free(s->origin);
     free(s->grad);
     free(s->dof);
     free(s->uv);
