@@ -149,6 +149,29 @@ static void test_local_matches_global(void)
     fs_mesh_free(&m);
 }
 
+/* A global solve with a stale factor that CG cannot finish (here: an iteration limit far too small)
+ * falls back to a fresh factorization and the direct solve, and gets the factor's answer. */
+static void test_stalled_cg_falls_back(void)
+{
+    fs_config cfg = base_config(4.0, FS_RELAX_LOCAL);
+    cfg.solver.max_iterations = 3;
+    fs_mesh m = {0};
+    CHECK(wedge_test_mesh(&cfg, 600, &m) == 0);
+    fs_wedge_model a, b;
+    pair_init_with(&m, cfg, &a, &b);
+    CHECK(fs_wedge_remove(&a, element_near(&m, 2.0, 2.0)) == 0);
+    CHECK(fs_wedge_remove(&b, element_near(&m, 2.0, 2.0)) == 0);
+    CHECK(a.factor_stale);
+    int64_t factorizations = a.counters.factorizations;
+    CHECK_MSG(fs_wedge_equilibrium(&a, 0.9) == 0, "%s", fs_error_message());
+    CHECK(fs_wedge_equilibrium(&b, 0.9) == 0);
+    CHECK(!a.factor_stale && a.counters.factorizations == factorizations + 1);
+    CHECK_MSG(u_diff(&a, &b) < 1e-9, "fallback and factor differ by %.3g of the largest", u_diff(&a, &b));
+    fs_wedge_free(&a);
+    fs_wedge_free(&b);
+    fs_mesh_free(&m);
+}
+
 /* Is the node in the list? */
 static bool listed(const int32_t *list, int32_t n, int32_t node)
 {
@@ -316,5 +339,6 @@ int main(void)
     RUN(test_crack_is_barrier);
     RUN(test_radius_control);
     RUN(test_far_change_is_local);
+    RUN(test_stalled_cg_falls_back);
     return check_finish();
 }

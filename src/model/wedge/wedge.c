@@ -790,10 +790,19 @@ static int solve(fs_wedge_model *w)
             p.block = 3; /* a node's three unknowns are consecutive (number_dofs) */
         }
         int it = fs_cg_solve(&w->k_free, w->rhs, w->x, p, NULL);
-        if (it < 0)
-            rc = -1;
-        else
+        if (it >= 0) {
             w->counters.cg_iterations += it;
+        } else if (w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
+            /* CG can stall on a mesh that many cuts have left ill-conditioned: a fresh analysis (the
+             * pattern has changed since the factor) and factorization, and the direct solve */
+            fs_debug("wedge: %s; solving with a fresh factorization", fs_error_message());
+            fs_error_clear();
+            rc = factorize(w, true);
+            if (rc == 0)
+                rc = fs_cholesky_solve(w->chol, 1, w->rhs, w->x);
+        } else {
+            rc = -1;
+        }
     }
     w->counters.solves++;
     w->counters.solve_seconds += fs_seconds() - t0;
