@@ -660,6 +660,177 @@ static void test_cg_reports_failures(void)
     fs_sparse_matrix_free(&a);
 }
 
+/* ---- fs_pcg on an operator ---- */
+
+/* A matrix as an operator with the Jacobi preconditioner, and a Euclidean stopping rule. */
+typedef struct {
+    const fs_sparse_matrix *a;
+    double *inv_diag;
+    double limit;
+    int32_t applies, fail_after; /* products so far; the preconditioner fails after this many calls (< 0: never) */
+    int32_t preconditions;
+    fs_cg_sum sum;
+} matrix_op;
+
+static void matrix_apply(void *ctx, const double *x, double *y)
+{
+    matrix_op *o = ctx;
+    o->applies++;
+    fs_sparse_matvec(o->a, x, y);
+}
+
+static int matrix_precondition(void *ctx, const double *r, double *z)
+{
+    matrix_op *o = ctx;
+    if (o->fail_after >= 0 && o->preconditions++ >= o->fail_after) {
+        fs_error(FS_ERR_INTERNAL, "test: preconditioner failed");
+        return -1;
+    }
+    for (int32_t i = 0; i < o->a->n; i++)
+        z[i] = o->inv_diag[i] * r[i];
+    return 0;
+}
+
+static bool matrix_converged(void *ctx, const double *r)
+{
+    const matrix_op *o = ctx;
+    return sqrt(fs_cg_dot(o->a->n, r, r, o->sum)) <= o->limit;
+}
+
+static void matrix_op_init(matrix_op *o, const fs_sparse_matrix *a, double limit, fs_cg_sum sum)
+{
+    memset(o, 0, sizeof *o);
+    o->a = a;
+    o->limit = limit;
+    o->fail_after = -1;
+    o->sum = sum;
+    o->inv_diag = malloc((size_t)a->n * sizeof *o->inv_diag);
+    for (int32_t j = 0; j < a->n; j++)
+        o->inv_diag[j] = 1.0 / a->values[a->col_ptr[j + 1] - 1]; /* the diagonal ends each column */
+}
+
+/* fs_cg_solve is fs_pcg on the matrix with the Jacobi preconditioner: the same iterations and the
+ * same solution bit for bit; the sequential sums converge too, to within the tolerance. */
+static void test_pcg_operator_matches_matrix_cg(void)
+{
+    enum { m = 20, n = m * m };
+    fs_sparse_matrix a;
+    assemble_poisson(m, &a);
+    double *b = random_vector(n, 21);
+    double *x_cg = calloc(n, sizeof *x_cg), *x = calloc(n, sizeof *x), *work = malloc(4 * n * sizeof *work);
+    fs_cg_params params = fs_cg_params_default();
+    params.tolerance = 1e-9;
+    int iterations = fs_cg_solve(&a, b, x_cg, params, NULL);
+    CHECK(iterations > 0);
+
+    matrix_op o;
+    matrix_op_init(&o, &a, params.tolerance * norm2(n, b), FS_CG_SUM_INTERLEAVED);
+    fs_cg_operator op = {n, matrix_apply, matrix_precondition, matrix_converged, &o};
+    fs_pcg_params pp = {n, FS_CG_SUM_INTERLEAVED, false, true};
+    fs_pcg_vectors v = {work, work + n, work + 2 * n, work + 3 * n};
+    fs_pcg_result res = fs_pcg(&op, b, x, &pp, v);
+    CHECK(res.status == FS_PCG_CONVERGED && res.iterations == iterations);
+    CHECK(memcmp(x, x_cg, n * sizeof *x) == 0);
+    CHECK(relative_residual(&a, x, b) <= params.tolerance);
+    /* on return r is the true residual b - A x */
+    double *ax = malloc(n * sizeof *ax);
+    fs_sparse_matvec(&a, x, ax);
+    double worst = 0.0;
+    for (int32_t i = 0; i < n; i++)
+        worst = fmax(worst, fabs(v.r[i] - (b[i] - ax[i])));
+    CHECK(worst == 0.0);
+
+    /* from zero with the recurrence residual and sequential sums: x's content is ignored */
+    for (int32_t i = 0; i < n; i++)
+        x[i] = 1e9;
+    o.sum = FS_CG_SUM_SEQUENTIAL;
+    o.applies = 0;
+    fs_pcg_params seq = {n, FS_CG_SUM_SEQUENTIAL, true, false};
+    res = fs_pcg(&op, b, x, &seq, v);
+    CHECK(res.status == FS_PCG_CONVERGED);
+    CHECK(o.applies == res.iterations); /* one product per iteration, none for the start */
+    CHECK_MSG(relative_residual(&a, x, b) <= 2 * params.tolerance, "residual %g", relative_residual(&a, x, b));
+    CHECK(relative_difference(n, x, x_cg) <= 1e-6);
+
+    /* a cap on the iterations, and a preconditioner that fails on its third call */
+    fs_pcg_params few = {3, FS_CG_SUM_SEQUENTIAL, true, false};
+    res = fs_pcg(&op, b, x, &few, v);
+    CHECK(res.status == FS_PCG_MAX_ITERATIONS && res.iterations == 3);
+    o.fail_after = 2;
+    fs_error_clear();
+    res = fs_pcg(&op, b, x, &seq, v);
+    CHECK(res.status == FS_PCG_FAILED && res.iterations == 2);
+    CHECK(strcmp(fs_error_message(), "test: preconditioner failed") == 0);
+    free(o.inv_diag);
+    free(ax);
+    free(work);
+    free(x);
+    free(x_cg);
+    free(b);
+    fs_sparse_matrix_free(&a);
+}
+
+/* A 2 x 2 operator given by its entries, preconditioner the identity. */
+typedef struct {
+    double a[4];
+} small_op;
+
+static void small_apply(void *ctx, const double *x, double *y)
+{
+    const small_op *o = ctx;
+    y[0] = o->a[0] * x[0] + o->a[1] * x[1];
+    y[1] = o->a[2] * x[0] + o->a[3] * x[1];
+}
+
+static int small_identity(void *ctx, const double *r, double *z)
+{
+    (void)ctx;
+    z[0] = r[0];
+    z[1] = r[1];
+    return 0;
+}
+
+static bool small_converged(void *ctx, const double *r)
+{
+    (void)ctx;
+    return fabs(r[0]) <= 1e-14 && fabs(r[1]) <= 1e-14;
+}
+
+/* By hand: CG solves an SPD 2 x 2 system in two iterations; an indefinite one breaks down on its
+ * first direction (p'Ap = 0), which fs_pcg reports with the curvature. */
+static void test_pcg_small_cases(void)
+{
+    small_op spd = {{4, 1, 1, 3}};
+    fs_cg_operator op = {2, small_apply, small_identity, small_converged, &spd};
+    double b[2] = {1, 2}, x[2] = {0, 0}, r[2], z[2], p[2], q[2];
+    fs_pcg_params params = {10, FS_CG_SUM_SEQUENTIAL, true, true};
+    fs_pcg_result res = fs_pcg(&op, b, x, &params, (fs_pcg_vectors){r, z, p, q});
+    CHECK(res.status == FS_PCG_CONVERGED && res.iterations == 2);
+    CHECK_NEAR(x[0], 1.0 / 11.0, 1e-15);
+    CHECK_NEAR(x[1], 7.0 / 11.0, 1e-15);
+    /* started at the solution with true_residual: no iteration */
+    res = fs_pcg(&op, b, x, &(fs_pcg_params){10, FS_CG_SUM_SEQUENTIAL, false, true}, (fs_pcg_vectors){r, z, p, q});
+    CHECK(res.status == FS_PCG_CONVERGED && res.iterations == 0);
+
+    small_op indefinite = {{1, 0, 0, -1}};
+    op.ctx = &indefinite;
+    double one[2] = {1, 1};
+    res = fs_pcg(&op, one, x, &params, (fs_pcg_vectors){r, z, p, q});
+    CHECK(res.status == FS_PCG_BREAKDOWN && res.iterations == 0);
+    CHECK(res.curvature == 0.0 && res.rz == 2.0);
+}
+
+/* The two summation orders by hand: sequential is one running sum, interleaved four partial sums. */
+static void test_cg_dot_orders(void)
+{
+    const double u[5] = {1e16, 1, -1e16, 1, 1}, v[5] = {1, 1, 1, 1, 1};
+    /* ((((1e16 + 1) - 1e16) + 1) + 1): the first 1 is lost to rounding */
+    CHECK(fs_cg_dot(5, u, v, FS_CG_SUM_SEQUENTIAL) == 2.0);
+    /* (1e16 + 1) + (1 + 1) ... partial sums s0 = 1e16 + 1, s1 = 1, s2 = -1e16, s3 = 1 */
+    CHECK(fs_cg_dot(5, u, v, FS_CG_SUM_INTERLEAVED) == ((1e16 + 1.0) + 1.0) + (-1e16 + 1.0));
+    CHECK(fs_cg_dot(0, u, v, FS_CG_SUM_SEQUENTIAL) == 0.0);
+}
+
 /* The Kronecker product of the m x m grid Laplacian with an SPD 3x3 coupling c: three unknowns per
  * grid point, strongly coupled within the point, like a node's displacement in elasticity. */
 static void assemble_coupled(int32_t m, const double c[9], fs_sparse_matrix *a)
@@ -830,5 +1001,8 @@ int main(void)
     RUN(test_cg_block_preconditioner);
     RUN(test_cg_principal_blocks);
     RUN(test_cg_max_residual);
+    RUN(test_pcg_operator_matches_matrix_cg);
+    RUN(test_pcg_small_cases);
+    RUN(test_cg_dot_orders);
     return check_finish();
 }

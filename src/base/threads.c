@@ -1,6 +1,7 @@
-/* The process-wide thread budget: what -j/--threads sets, read by the code that starts threads. */
+/* The process-wide thread budget (what -j/--threads sets) and the parallel loop that spends it. */
 #include "base/threads.h"
 
+#include <pthread.h>
 #include <unistd.h>
 
 static int requested = -1; /* -1: never set; 0: one per online processor */
@@ -15,4 +16,51 @@ int fs_threads(void)
         return requested;
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     return n < 1 ? 1 : (n > FS_THREADS_MAX ? FS_THREADS_MAX : (int)n);
+}
+
+/* The shared state of one fs_parallel_for: the next item to hand out. */
+typedef struct {
+    int32_t n, next;
+    fs_parallel_fn fn;
+    void *ctx;
+    pthread_mutex_t lock;
+} parallel_loop;
+
+static void *parallel_worker(void *arg)
+{
+    parallel_loop *loop = arg;
+    for (;;) {
+        pthread_mutex_lock(&loop->lock);
+        int32_t i = loop->next < loop->n ? loop->next++ : -1;
+        pthread_mutex_unlock(&loop->lock);
+        if (i < 0)
+            return NULL;
+        loop->fn(loop->ctx, i);
+    }
+}
+
+void fs_parallel_for(int32_t n, int threads, fs_parallel_fn fn, void *ctx)
+{
+    if (n <= 0)
+        return;
+    if (threads <= 0)
+        threads = fs_threads();
+    if (threads > FS_THREADS_MAX)
+        threads = FS_THREADS_MAX;
+    if (threads > n)
+        threads = (int)n;
+    if (threads <= 1) {
+        for (int32_t i = 0; i < n; i++)
+            fn(ctx, i);
+        return;
+    }
+    parallel_loop loop = {n, 0, fn, ctx, PTHREAD_MUTEX_INITIALIZER};
+    pthread_t thread[FS_THREADS_MAX];
+    bool started[FS_THREADS_MAX] = {false};
+    for (int t = 1; t < threads; t++)
+        started[t] = pthread_create(&thread[t], NULL, parallel_worker, &loop) == 0;
+    parallel_worker(&loop);
+    for (int t = 1; t < threads; t++)
+        if (started[t])
+            pthread_join(thread[t], NULL);
 }

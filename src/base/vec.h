@@ -1,4 +1,4 @@
-/* Small 2-D / 3-D vector helpers on plain double arrays. */
+/* Small 2-D / 3-D vector and 3x3 matrix helpers on plain double arrays. */
 #ifndef FS_BASE_VEC_H
 #define FS_BASE_VEC_H
 
@@ -25,6 +25,36 @@ static inline void fs_cross3(double *out, const double *a, const double *b)
 static inline double fs_orient2(const double *a, const double *b, const double *c)
 {
     return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+/* The adjugate (transposed cofactors) of the row-major 3x3 matrix m into adj (not aliasing m), so that
+ * m adj = det(m) I; returns det(m), expanded along the first row (m[0] adj[0] + m[1] adj[3] +
+ * m[2] adj[6]). adj[8] = m[0] m[4] - m[1] m[3] is the leading 2x2 minor: with m[0] and det, the
+ * test of positive definiteness of a symmetric m. */
+static inline double fs_mat3_adjugate(const double *m, double *adj)
+{
+    adj[0] = m[4] * m[8] - m[5] * m[7];
+    adj[1] = m[2] * m[7] - m[1] * m[8];
+    adj[2] = m[1] * m[5] - m[2] * m[4];
+    adj[3] = m[5] * m[6] - m[3] * m[8];
+    adj[4] = m[0] * m[8] - m[2] * m[6];
+    adj[5] = m[2] * m[3] - m[0] * m[5];
+    adj[6] = m[3] * m[7] - m[4] * m[6];
+    adj[7] = m[1] * m[6] - m[0] * m[7];
+    adj[8] = m[0] * m[4] - m[1] * m[3];
+    return m[0] * adj[0] + m[1] * adj[3] + m[2] * adj[6];
+}
+
+/* The inverse of the row-major 3x3 matrix m into inv (may alias m): adj(m) / det(m), each entry
+ * divided (not multiplied by 1 / det). Returns det(m); when it is 0 inv holds infinities or NaN, so
+ * a caller that can meet a singular m tests the result. */
+static inline double fs_mat3_inverse(const double *m, double *inv)
+{
+    double adj[9];
+    double det = fs_mat3_adjugate(m, adj);
+    for (int k = 0; k < 9; k++)
+        inv[k] = adj[k] / det;
+    return det;
 }
 
 #endif

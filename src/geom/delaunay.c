@@ -3,7 +3,6 @@
 
 #include <libqhull_r/libqhull_r.h>
 #include <math.h>
-#include <pthread.h>
 #include <setjmp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -701,44 +700,8 @@ static void run_block(block_job *job)
     }
 }
 
-/* Blocks handed out in turn to whichever thread is free (they differ in cost, and a thread may
- * be held up by other work on the machine). */
-typedef struct {
-    block_job *jobs;
-    int njobs, next;
-    pthread_mutex_t lock;
-} block_queue;
-
-static void *block_worker_main(void *arg)
-{
-    block_queue *q = arg;
-    for (;;) {
-        pthread_mutex_lock(&q->lock);
-        int j = q->next < q->njobs ? q->next++ : -1;
-        pthread_mutex_unlock(&q->lock);
-        if (j < 0)
-            return NULL;
-        run_block(&q->jobs[j]);
-    }
-}
-
-/* Runs the blocks on up to fs_threads() threads (base/threads.h); the result does not depend on the thread
- * count nor on which thread runs which block (each block's output depends only on the input).
- * Threads that cannot be started leave their blocks to the others. */
-static void run_blocks(block_job *jobs, int njobs)
-{
-    int budget = fs_threads();
-    int nthreads = budget < njobs ? budget : njobs;
-    block_queue q = {jobs, njobs, 0, PTHREAD_MUTEX_INITIALIZER};
-    pthread_t thread[MAX_BLOCKS];
-    bool started[MAX_BLOCKS] = {false};
-    for (int t = 1; t < nthreads; t++)
-        started[t] = pthread_create(&thread[t], NULL, block_worker_main, &q) == 0;
-    block_worker_main(&q);
-    for (int t = 1; t < nthreads; t++)
-        if (started[t])
-            pthread_join(thread[t], NULL);
-}
+/* Block j of the jobs ctx, one item of the parallel loop of the blocks. */
+static void block_item(void *ctx, int32_t j) { run_block((block_job *)ctx + j); }
 
 typedef enum {
     MESH_OK,
@@ -824,7 +787,9 @@ static mesh_check triangulate_blocks(fs_mesh *m, plane_setup *s, double margin, 
         jobs[b].b = b;
         jobs[b].margin = margin;
     }
-    run_blocks(jobs, nb);
+    /* on up to fs_threads() threads (base/threads.h): the result does not depend on the thread count
+     * nor on which thread runs which block (each block's output depends only on the input) */
+    fs_parallel_for(nb, 0, block_item, jobs);
     int64_t total = 0;
     int status = 0;
     for (int b = 0; b < nb; b++) {

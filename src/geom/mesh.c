@@ -5,7 +5,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
+#include "base/uf.h"
 #include "base/vec.h"
 
 /* Period of the domain along x / y, or 0 in a direction that does not wrap. */
@@ -377,6 +379,90 @@ int fs_mesh_update_adjacency(fs_mesh *m, int32_t n_tris_before, const int32_t *c
     return rc;
 }
 
+bool fs_mesh_check(const fs_mesh *m, char *why, size_t len)
+{
+    char dummy[8];
+    if (!why) {
+        why = dummy;
+        len = sizeof dummy;
+    }
+    int32_t nh = 3 * m->n_tris;
+    for (int32_t t = 0; t < m->n_tris; t++) {
+        const int32_t *v = m->tri + 3 * (size_t)t;
+        for (int k = 0; k < 3; k++)
+            if (v[k] < 0 || v[k] >= m->n_nodes) {
+                snprintf(why, len, "triangle %d: corner %d is node %d, not one of the %d nodes", (int)t, k, (int)v[k],
+                         (int)m->n_nodes);
+                return false;
+            }
+        if (v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) {
+            snprintf(why, len, "triangle %d has node %d twice", (int)t, (int)(v[0] == v[1] || v[0] == v[2] ? v[0] : v[1]));
+            return false;
+        }
+        double area = fs_mesh_tri_area(m, t);
+        if (!(area > 0.0)) {
+            snprintf(why, len, "triangle %d (nodes %d %d %d) has signed area %g: inverted or degenerate", (int)t,
+                     (int)v[0], (int)v[1], (int)v[2], area);
+            return false;
+        }
+    }
+    if (!m->adj) {
+        snprintf(why, len, "the mesh has no adjacency");
+        return false;
+    }
+    int32_t *start, *list;
+    node_half_edges(m, &start, &list);
+    bool ok = true;
+    for (int32_t h = 0; h < nh && ok; h++) {
+        half_edge e = half_edge_of(m, h);
+        int32_t u = m->adj[h];
+        if (u >= m->n_tris || (u >= 0 && partner(m, h) < 0)) {
+            snprintf(why, len, "triangle %d, edge %d (nodes %d-%d): its neighbour %d does not share it back", (int)(h / 3),
+                     (int)(h % 3), (int)e.from, (int)e.to, (int)u);
+            ok = false;
+        }
+        for (int32_t p = start[e.from]; p < start[e.from + 1] && ok; p++)
+            if (list[p] != h && same_direction(half_edge_of(m, list[p]), e)) {
+                snprintf(why, len, "edge %d-%d runs the same way in triangles %d and %d: not a manifold, or not "
+                         "consistently oriented", (int)e.from, (int)e.to, (int)(h / 3), (int)(list[p] / 3));
+                ok = false;
+            }
+        for (int32_t p = start[e.to]; p < start[e.to + 1] && ok && u < 0; p++)
+            if (opposite(half_edge_of(m, list[p]), e)) {
+                snprintf(why, len, "edge %d-%d of triangles %d and %d is not joined in adj", (int)e.from, (int)e.to,
+                         (int)(h / 3), (int)(list[p] / 3));
+                ok = false;
+            }
+    }
+    /* one fan per node: corners of a node joined across their shared edges at it (a half-edge from
+     * the node joins the corner at its start with the neighbour's corner there; its partner starts at
+     * the other end, so each shared edge at the node is seen from the triangle where it leaves it) */
+    int32_t *parent = NULL;
+    if (ok) {
+        parent = fs_malloc(((size_t)nh + 1) * sizeof *parent);
+        fs_uf_init(parent, nh);
+        for (int32_t h = 0; h < nh; h++) {
+            int32_t g = partner(m, h);
+            if (g >= 0) /* g runs from h's end to h's start: its end corner (g's next) is h's corner */
+                fs_uf_union(parent, h, 3 * (g / 3) + (g % 3 + 1) % 3);
+        }
+        for (int32_t i = 0; i < m->n_nodes && ok; i++) {
+            int32_t fans = 0;
+            for (int32_t p = start[i]; p < start[i + 1]; p++)
+                fans += fs_uf_find(parent, list[p]) == list[p];
+            if (fans > 1) {
+                snprintf(why, len, "node %d: its %d triangles form %d fans (a pinched node, not a manifold)", (int)i,
+                         (int)(start[i + 1] - start[i]), (int)fans);
+                ok = false;
+            }
+        }
+    }
+    free(parent);
+    free(start);
+    free(list);
+    return ok;
+}
+
 void fs_mesh_drop_derived(fs_mesh *m)
 {
     free(m->edge);
@@ -631,13 +717,12 @@ typedef struct {
 
 static void poly_reserve(poly_buf *p, int n)
 {
-    if (n <= p->cap)
-        return;
-    p->cap = 2 * n + 16;
-    p->x = fs_realloc(p->x, (size_t)p->cap * sizeof *p->x);
-    p->y = fs_realloc(p->y, (size_t)p->cap * sizeof *p->y);
-    p->tx = fs_realloc(p->tx, (size_t)p->cap * sizeof *p->tx);
-    p->ty = fs_realloc(p->ty, (size_t)p->cap * sizeof *p->ty);
+    if (FS_ARRAY_GROW(p->cap, n, 64)) {
+        FS_ARRAY_RESIZE(p->x, p->cap);
+        FS_ARRAY_RESIZE(p->y, p->cap);
+        FS_ARRAY_RESIZE(p->tx, p->cap);
+        FS_ARRAY_RESIZE(p->ty, p->cap);
+    }
 }
 
 /* Area of a polygon (relative coordinates, CCW) clipped to the box shifted by -origin. */

@@ -2,6 +2,7 @@
 #ifndef FS_GEOM_MESH_H
 #define FS_GEOM_MESH_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -57,6 +58,17 @@ int fs_mesh_build_adjacency(fs_mesh *m);
  * triangles and their neighbours (plus a pass over a byte per triangle). Returns 0, or -1 with
  * fs_error(FS_ERR_DATA) for a non-manifold edge. */
 int fs_mesh_update_adjacency(fs_mesh *m, int32_t n_tris_before, const int32_t *changed, int32_t n_changed);
+
+/* Checks the invariants every model's mesh keeps, after construction and after every cut: corners
+ * are nodes of the mesh; each triangle has positive signed area (counter-clockwise, fs_mesh_tri_area)
+ * and its corners are distinct; adj is symmetric and pairs half-edges that run the other way along
+ * the same edge (same nodes and image offset), and every such pair is joined (no two triangles share
+ * an edge without knowing it); no directed edge occurs twice (the mesh is consistently oriented
+ * and each edge has at most two triangles); the triangles at each node form one fan joined across
+ * its edges (the mesh is a manifold at every node: a crack always duplicates the nodes it
+ * disconnects). Cost O(n_tris) plus a sort per node of its corners. Returns true, or false with a
+ * message naming the triangle, node or edge in why (len bytes, may be NULL). */
+bool fs_mesh_check(const fs_mesh *m, char *why, size_t len);
 
 /* Frees the edge arrays and the rings (after a change that invalidates them, for users that do not
  * need them; fs_mesh_build_edges and fs_mesh_build_rings make them again). */

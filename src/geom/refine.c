@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/sort.h"
 #include "base/vec.h"
@@ -260,10 +261,7 @@ static void add_split(refiner *r, int32_t t)
         r->split_cap = cap;
     }
     set_insert(r->split_set, r->split_cap, t);
-    if (r->n_split == r->cap_split_list) {
-        r->cap_split_list = 2 * r->cap_split_list + 64;
-        r->split_list = fs_realloc(r->split_list, (size_t)r->cap_split_list * sizeof *r->split_list);
-    }
+    FS_ARRAY_RESERVE(r->split_list, r->cap_split_list, r->n_split + 1, 64);
     r->split_list[r->n_split++] = t;
 }
 
@@ -442,10 +440,7 @@ static void split_edge(refiner *r, int32_t t, int i, int32_t u, int iu)
 
 static void push(refiner *r, int32_t t)
 {
-    if (r->n_stack == r->cap_stack) {
-        r->cap_stack = r->cap_stack ? 2 * r->cap_stack : 64;
-        r->stack = fs_realloc(r->stack, (size_t)r->cap_stack * sizeof *r->stack);
-    }
+    FS_ARRAY_RESERVE(r->stack, r->cap_stack, r->n_stack + 1, 64);
     r->stack[r->n_stack++] = t;
 }
 
@@ -548,10 +543,7 @@ static int32_t walk_ring(const fs_mesh *m, int32_t k0, int32_t limit, int32_t **
     }
     int32_t begin = *n, count = 0, k = start, lowest = 0;
     do {
-        if (*n == *cap) {
-            *cap = 2 * *cap + 64;
-            *buf = fs_realloc(*buf, (size_t)*cap * sizeof **buf);
-        }
+        FS_ARRAY_RESERVE(*buf, *cap, *n + 1, 64);
         if (count == 0 || k < (*buf)[begin + lowest])
             lowest = count;
         (*buf)[(*n)++] = k;

@@ -2,10 +2,10 @@
 #include "geom/sample.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdbool.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/rng.h"
 #include "base/threads.h"
@@ -212,9 +212,10 @@ static int32_t particle_bucket(const relax_state *s, int32_t i)
     return best;
 }
 
-/* design: the passes of an iteration run on up to fs_threads() threads (at most MAX_THREADS), and the
- * result does not depend on the thread count: per-particle passes split the particles into
- * contiguous ranges, the bucket sort stays stable (each range counts its own buckets, and a range's
+/* design: the passes of an iteration run on up to fs_threads() threads (at most MAX_THREADS), each
+ * pass one fs_parallel_for over its tasks (base/threads.h), and the result does not depend on the
+ * thread count: per-particle passes split the particles into contiguous ranges (fs_parallel_part,
+ * one range per thread), the bucket sort stays stable (each range counts its own buckets, and a range's
  * particles go after those of the ranges before it), and the force pass keeps the sequential order
  * of every floating-point sum (see all_forces). */
 #define MAX_THREADS 8
@@ -243,42 +244,6 @@ typedef struct {
     double step, maxmove;
 } relax_task;
 
-/* Tasks handed out in turn to whichever thread is free. */
-typedef struct {
-    void *(*fn)(void *);
-    relax_task *task;
-    int n_tasks, next;
-    pthread_mutex_t lock;
-} task_queue;
-
-static void *task_worker(void *arg)
-{
-    task_queue *q = arg;
-    for (;;) {
-        pthread_mutex_lock(&q->lock);
-        int t = q->next < q->n_tasks ? q->next++ : -1;
-        pthread_mutex_unlock(&q->lock);
-        if (t < 0)
-            return NULL;
-        q->fn(&q->task[t]);
-    }
-}
-
-/* Runs fn on tasks [0, n_tasks) on the calling thread and up to nthreads - 1 more (a thread that
- * cannot be started leaves its share to the others). */
-static void run_tasks(void *(*fn)(void *), relax_task *task, int n_tasks, int nthreads)
-{
-    task_queue q = {fn, task, n_tasks, 0, PTHREAD_MUTEX_INITIALIZER};
-    pthread_t thread[MAX_THREADS];
-    bool started[MAX_THREADS] = {false};
-    for (int t = 1; t < nthreads && t < n_tasks; t++)
-        started[t] = pthread_create(&thread[t], NULL, task_worker, &q) == 0;
-    task_worker(&q);
-    for (int t = 1; t < nthreads && t < n_tasks; t++)
-        if (started[t])
-            pthread_join(thread[t], NULL);
-}
-
 /* Splits the particles into s->nthreads contiguous ranges. */
 static void particle_tasks(relax_state *s, relax_task *task)
 {
@@ -286,15 +251,14 @@ static void particle_tasks(relax_state *s, relax_task *task)
         memset(&task[t], 0, sizeof task[t]);
         task[t].s = s;
         task[t].t = t;
-        task[t].i0 = (int32_t)((int64_t)s->n * t / s->nthreads);
-        task[t].i1 = (int32_t)((int64_t)s->n * (t + 1) / s->nthreads);
+        fs_parallel_part(s->n, s->nthreads, t, &task[t].i0, &task[t].i1);
     }
 }
 
 /* Bucket sort, first pass: the bucket of each particle of the range, counted per range. */
-static void *sort_keys(void *arg)
+static void sort_keys(void *tasks, int32_t item)
 {
-    relax_task *task = arg;
+    relax_task *task = (relax_task *)tasks + item;
     relax_state *s = task->s;
     int32_t *count = s->tcount + (size_t)task->t * (size_t)s->n_buckets;
     memset(count, 0, (size_t)s->n_buckets * sizeof *count);
@@ -303,14 +267,13 @@ static void *sort_keys(void *arg)
         s->key[i] = b;
         count[b]++;
     }
-    return NULL;
 }
 
 /* Bucket sort, last pass: each particle of the range to its place in the snapshot (its range's
  * count array now holds where the range's next particle of each bucket goes); clears the forces. */
-static void *sort_scatter(void *arg)
+static void sort_scatter(void *tasks, int32_t item)
 {
-    relax_task *task = arg;
+    relax_task *task = (relax_task *)tasks + item;
     relax_state *s = task->s;
     int dims = s->sphere ? 3 : 2;
     int32_t *next = s->tcount + (size_t)task->t * (size_t)s->n_buckets;
@@ -323,7 +286,6 @@ static void *sort_scatter(void *arg)
     }
     for (int a = 0; a < dims; a++)
         memset(s->f[a] + task->i0, 0, (size_t)(task->i1 - task->i0) * sizeof(double));
-    return NULL;
 }
 
 /* Stable counting sort of the particles into buckets (the snapshot and start), with the forces
@@ -334,7 +296,7 @@ static void bucket_sort(relax_state *s)
     int32_t nb = s->n_buckets;
     int nt = s->nthreads;
     particle_tasks(s, task);
-    run_tasks(sort_keys, task, nt, nt);
+    fs_parallel_for(nt, nt, sort_keys, task);
     int32_t sum = 0;
     for (int32_t b = 0; b < nb; b++) {
         s->start[b] = sum;
@@ -346,7 +308,7 @@ static void bucket_sort(relax_state *s)
         }
     }
     s->start[nb] = sum;
-    run_tasks(sort_scatter, task, nt, nt);
+    fs_parallel_for(nt, nt, sort_scatter, task);
 }
 
 /* Appends particles [j0, j1) with a shift to a list of ranges, merging it into the last range when
@@ -460,10 +422,7 @@ static double coincident_push(const relax_state *s, int32_t k, int32_t j)
 /* Appends a force on snapshot particle j to a task's log. */
 static void log_force(relax_task *task, int32_t j, const double *v)
 {
-    if (task->n_log == task->cap_log) {
-        task->cap_log = task->cap_log ? 2 * task->cap_log : 1024;
-        task->log = fs_realloc(task->log, (size_t)task->cap_log * sizeof *task->log);
-    }
+    FS_ARRAY_RESERVE(task->log, task->cap_log, task->n_log + 1, 1024);
     force_entry *e = &task->log[task->n_log++];
     e->j = j;
     for (int a = 0; a < 3; a++)
@@ -565,9 +524,9 @@ static int32_t row_bucket(const relax_state *s, int32_t iy)
 }
 
 /* Forces from the cells of rows [row0, row1), cell by cell in bucket order. */
-static void *row_forces(void *arg)
+static void row_forces(void *tasks, int32_t item)
 {
-    relax_task *task = arg;
+    relax_task *task = (relax_task *)tasks + item;
     relax_state *s = task->s;
     neighbour nb[MAX_RANGES];
     int32_t b = row_bucket(s, task->row0);
@@ -603,7 +562,6 @@ static void *row_forces(void *arg)
             }
         }
     FS_ASSERT(b == row_bucket(s, task->row1));
-    return NULL;
 }
 
 /* design: forces on every particle of the snapshot (cleared by bucket_sort), summed in the order of
@@ -641,7 +599,7 @@ static void all_forces(relax_state *s)
         task[t].row1 = rows[t + 1];
         task[t].log_below = t == 0 ? 0 : s->start[row_bucket(s, rows[t] + 1)];
     }
-    run_tasks(row_forces, task, nt, s->nthreads);
+    fs_parallel_for(nt, s->nthreads, row_forces, task);
     int dims = s->sphere ? 3 : 2;
     for (int t = 1; t < nt; t++) {
         for (int32_t e = 0; e < task[t].n_log; e++) {
@@ -670,9 +628,9 @@ static double move_coord(double v, double dv, double ext, bool periodic)
 }
 
 /* Moves the particles of a task's range by step * force, capped at maxmove, back into the domain. */
-static void *move_particles(void *arg)
+static void move_particles(void *tasks, int32_t item)
 {
-    relax_task *task = arg;
+    relax_task *task = (relax_task *)tasks + item;
     relax_state *s = task->s;
     int dims = s->sphere ? 3 : 2;
     double step = task->step, maxmove = task->maxmove;
@@ -698,7 +656,6 @@ static void *move_particles(void *arg)
         s->r[k] = s->sr[k];
         s->id[k] = s->sid[k];
     }
-    return NULL;
 }
 
 /* One Jacobi iteration: forces from the snapshot, then every particle moves by step * force, capped
@@ -712,7 +669,7 @@ static void relax_step(relax_state *s, double step, double maxmove)
         task[t].step = step;
         task[t].maxmove = maxmove;
     }
-    run_tasks(move_particles, task, s->nthreads, s->nthreads);
+    fs_parallel_for(s->nthreads, s->nthreads, move_particles, task);
 }
 
 static int32_t cells_along(double ext, double dmax)

@@ -5,6 +5,7 @@
 #include <stdbool.h>
 #include <stdlib.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/vec.h"
 
@@ -153,10 +154,7 @@ static void edge_points(const fs_sphere_refiner *s, const point *a, const point 
         edge_points(s, &m, b, depth + 1, list, n, cap);
         return;
     }
-    if (*n == *cap) {
-        *cap = *cap ? 2 * *cap : 32;
-        *list = fs_realloc(*list, (size_t)*cap * sizeof **list);
-    }
+    FS_ARRAY_RESERVE(*list, *cap, *n + 1, 32);
     (*list)[(*n)++] = *a;
 }
 

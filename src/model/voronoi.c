@@ -5,6 +5,7 @@
 #include <stdbool.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/rng.h"
 #include "base/vec.h"
@@ -110,10 +111,9 @@ typedef struct {
 
 static void poly_push(polygon *poly, const double *p, int label)
 {
-    if (poly->n == poly->cap) {
-        poly->cap = poly->cap ? 2 * poly->cap : 64;
-        poly->p = fs_realloc(poly->p, 3 * (size_t)poly->cap * sizeof *poly->p);
-        poly->label = fs_realloc(poly->label, (size_t)poly->cap);
+    if (FS_ARRAY_GROW(poly->cap, poly->n + 1, 64)) {
+        FS_ARRAY_RESIZE(poly->p, 3 * (size_t)poly->cap);
+        FS_ARRAY_RESIZE(poly->label, poly->cap);
     }
     memcpy(poly->p + 3 * (size_t)poly->n, p, 3 * sizeof *p);
     poly->label[poly->n++] = (uint8_t)label;
@@ -333,10 +333,7 @@ static void cell_polyline(ctx *c, const polygon *poly)
 
 static int band_vertex_add(ctx *c, const double *p, attr a)
 {
-    if (c->n_bv == c->cap_bv) {
-        c->cap_bv = c->cap_bv ? 2 * c->cap_bv : 64;
-        c->bv = fs_realloc(c->bv, (size_t)c->cap_bv * sizeof *c->bv);
-    }
+    FS_ARRAY_RESERVE(c->bv, c->cap_bv, c->n_bv + 1, 64);
     band_vertex *v = c->bv + c->n_bv;
     memcpy(v->p, p, sizeof v->p);
     v->a = a;
@@ -345,10 +342,7 @@ static int band_vertex_add(ctx *c, const double *p, attr a)
 
 static void band_tri_add(ctx *c, int a, int b, int d)
 {
-    if (c->n_bt + 3 > c->cap_bt) {
-        c->cap_bt = c->cap_bt ? 2 * c->cap_bt : 192;
-        c->bt = fs_realloc(c->bt, (size_t)c->cap_bt * sizeof *c->bt);
-    }
+    FS_ARRAY_RESERVE(c->bt, c->cap_bt, c->n_bt + 3, 192);
     c->bt[c->n_bt++] = a;
     c->bt[c->n_bt++] = b;
     c->bt[c->n_bt++] = d;

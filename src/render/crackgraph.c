@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/vec.h"
 #include "image/image.h"
@@ -140,8 +141,7 @@ static void thin(const grid *g, uint8_t *fg)
     int32_t *border = fs_malloc(cap * sizeof *border);
     for (size_t k = 0; k < n; k++)
         if (fg[k] && has_background_4(g, fg, (int32_t)k)) {
-            if (n_border == cap)
-                border = fs_realloc(border, (cap *= 2) * sizeof *border);
+            FS_ARRAY_RESERVE(border, cap, n_border + 1, 1024);
             border[n_border++] = (int32_t)k;
             listed[k] = 1;
         }
@@ -175,9 +175,7 @@ static void thin(const grid *g, uint8_t *fg)
                     int32_t q = grid_step(g, k % g->w, k / g->w, ring_dx[r], ring_dy[r]);
                     if (q < 0 || !fg[q] || listed[q])
                         continue;
-                    if (n_border == cap) {
-                        border = fs_realloc(border, (cap *= 2) * sizeof *border);
-                    }
+                    FS_ARRAY_RESERVE(border, cap, n_border + 1, 1024);
                     border[n_border++] = q;
                     listed[q] = 1;
                 }
@@ -237,20 +235,16 @@ typedef struct {
 
 static int32_t add_node(tracer *t, double x, double y, double half_width, fs_crack_node_kind kind)
 {
-    if (t->n_nodes == t->cap_nodes) {
-        t->cap_nodes = t->cap_nodes ? 2 * t->cap_nodes : 256;
-        t->node = fs_realloc(t->node, (size_t)t->cap_nodes * sizeof *t->node);
-    }
+    FS_ARRAY_RESERVE(t->node, t->cap_nodes, t->n_nodes + 1, 256);
     t->node[t->n_nodes] = (tnode){x, y, half_width, kind, 0, false};
     return t->n_nodes++;
 }
 
 static void add_point(tracer *t, double x, double y, int32_t pixel)
 {
-    if (t->n_pts == t->cap_pts) {
-        t->cap_pts = t->cap_pts ? 2 * t->cap_pts : 4096;
-        t->pts = fs_realloc(t->pts, (size_t)t->cap_pts * sizeof *t->pts);
-        t->pix = fs_realloc(t->pix, (size_t)t->cap_pts * sizeof *t->pix);
+    if (FS_ARRAY_GROW(t->cap_pts, t->n_pts + 1, 4096)) {
+        FS_ARRAY_RESIZE(t->pts, t->cap_pts);
+        FS_ARRAY_RESIZE(t->pix, t->cap_pts);
     }
     t->pts[t->n_pts] = (pt){x, y};
     t->pix[t->n_pts++] = pixel;
@@ -258,10 +252,7 @@ static void add_point(tracer *t, double x, double y, int32_t pixel)
 
 static int32_t add_edge(tracer *t, int32_t a, int32_t b, int32_t first)
 {
-    if (t->n_edges == t->cap_edges) {
-        t->cap_edges = t->cap_edges ? 2 * t->cap_edges : 256;
-        t->edge = fs_realloc(t->edge, (size_t)t->cap_edges * sizeof *t->edge);
-    }
+    FS_ARRAY_RESERVE(t->edge, t->cap_edges, t->n_edges + 1, 256);
     t->edge[t->n_edges] = (tedge){{a, b}, first, t->n_pts - first, false};
     return t->n_edges++;
 }
@@ -630,10 +621,8 @@ typedef struct {
 
 static void out_point(out_pools *o, double u, double v)
 {
-    if (o->n_points == o->cap_points) {
-        o->cap_points = o->cap_points ? 2 * o->cap_points : 4096;
-        o->g->point = fs_realloc(o->g->point, 2 * (size_t)o->cap_points * sizeof *o->g->point);
-    }
+    if (FS_ARRAY_GROW(o->cap_points, o->n_points + 1, 4096))
+        FS_ARRAY_RESIZE(o->g->point, 2 * (size_t)o->cap_points);
     u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
     v = v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v;
     o->g->point[2 * o->n_points] = u;
@@ -644,10 +633,7 @@ static void out_point(out_pools *o, double u, double v)
 static void out_piece_start(out_pools *o)
 {
     fs_crackgraph *g = o->g;
-    if (g->n_pieces + 1 >= o->cap_pieces) {
-        o->cap_pieces = o->cap_pieces ? 2 * o->cap_pieces : 1024;
-        g->piece_start = fs_realloc(g->piece_start, (size_t)o->cap_pieces * sizeof *g->piece_start);
-    }
+    FS_ARRAY_RESERVE(g->piece_start, o->cap_pieces, g->n_pieces + 2, 1024);
     g->piece_start[g->n_pieces++] = o->n_points;
 }
 
@@ -854,8 +840,7 @@ static void build_fragments(const grid *g, const uint16_t *cell, const uint16_t 
                 if (q < 0 || label[q] == label[k] || !label[q] || !label[k])
                     continue;
                 uint16_t a = label[k] < label[q] ? label[k] : label[q], b = label[k] ^ label[q] ^ a;
-                if (np == cap)
-                    pairs = fs_realloc(pairs, (cap *= 2) * sizeof *pairs);
+                FS_ARRAY_RESERVE(pairs, cap, np + 1, 4096);
                 pairs[np++] = (uint32_t)a << 16 | b;
             }
         }

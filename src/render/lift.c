@@ -5,8 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
+#include "base/uf.h"
 #include "base/vec.h"
 
 /* Positions closer than this fraction of the domain's size are one vertex. The render mesh gives
@@ -195,10 +197,9 @@ static int32_t weld_search(welder *w, const double *x)
             }
     if (best >= 0)
         return best;
-    if (w->n == w->cap) {
-        w->cap = w->cap ? 2 * w->cap : 1024;
-        w->p = fs_realloc(w->p, 3 * (size_t)w->cap * sizeof *w->p);
-        w->next = fs_realloc(w->next, (size_t)w->cap * sizeof *w->next);
+    if (FS_ARRAY_GROW(w->cap, w->n + 1, 1024)) {
+        FS_ARRAY_RESIZE(w->p, 3 * (size_t)w->cap);
+        FS_ARRAY_RESIZE(w->next, w->cap);
     }
     int32_t i = w->n++;
     memcpy(w->p + 3 * (size_t)i, x, 3 * sizeof *x);
@@ -224,11 +225,10 @@ static int32_t weld(welder *w, const double *x)
         if (!memcmp(w->q + 3 * (size_t)i, x, 3 * sizeof *x))
             return w->q_answer[i];
     int32_t answer = weld_search(w, x);
-    if (w->n_q == w->cap_q) {
-        w->cap_q = w->cap_q ? 2 * w->cap_q : 1024;
-        w->q = fs_realloc(w->q, 3 * (size_t)w->cap_q * sizeof *w->q);
-        w->q_answer = fs_realloc(w->q_answer, (size_t)w->cap_q * sizeof *w->q_answer);
-        w->q_next = fs_realloc(w->q_next, (size_t)w->cap_q * sizeof *w->q_next);
+    if (FS_ARRAY_GROW(w->cap_q, w->n_q + 1, 1024)) {
+        FS_ARRAY_RESIZE(w->q, 3 * (size_t)w->cap_q);
+        FS_ARRAY_RESIZE(w->q_answer, w->cap_q);
+        FS_ARRAY_RESIZE(w->q_next, w->cap_q);
     }
     int32_t i = w->n_q++;
     memcpy(w->q + 3 * (size_t)i, x, 3 * sizeof *x);
@@ -268,10 +268,9 @@ static int32_t dedup_add(dedup *d, const float *x)
     for (int32_t i = *slot; i >= 0; i = d->next[i])
         if (!memcmp(d->v + (size_t)d->dim * (size_t)i, x, (size_t)d->dim * sizeof *x))
             return i;
-    if (d->n == d->cap) {
-        d->cap = d->cap ? 2 * d->cap : 1024;
-        d->v = fs_realloc(d->v, (size_t)d->dim * (size_t)d->cap * sizeof *d->v);
-        d->next = fs_realloc(d->next, (size_t)d->cap * sizeof *d->next);
+    if (FS_ARRAY_GROW(d->cap, d->n + 1, 1024)) {
+        FS_ARRAY_RESIZE(d->v, (size_t)d->dim * (size_t)d->cap);
+        FS_ARRAY_RESIZE(d->next, d->cap);
     }
     int32_t i = d->n++;
     memcpy(d->v + (size_t)d->dim * (size_t)i, x, (size_t)d->dim * sizeof *x);
@@ -352,10 +351,7 @@ static uvh cut(lift_ctx *c, const uvh *a, const uvh *b, int axis, double line)
     int map = 2 * axis + (!c->wrap[axis] && line > 0.5);
     int32_t *slot = imap_get(&c->cut_map[map], pair_key(a->id, b->id), c->n_cuts, &found);
     if (!found) {
-        if (c->n_cuts == c->cap_cuts) {
-            c->cap_cuts = c->cap_cuts ? 2 * c->cap_cuts : 256;
-            c->cuts = fs_realloc(c->cuts, (size_t)c->cap_cuts * sizeof *c->cuts);
-        }
+        FS_ARRAY_RESERVE(c->cuts, c->cap_cuts, c->n_cuts + 1, 256);
         if (axis)
             x.v = line;
         else
@@ -394,10 +390,7 @@ static int clip_half(lift_ctx *c, const uvh *in, int n, int axis, double line, d
 
 static void push_tri(lift_ctx *c, tri t)
 {
-    if (c->n_t == c->cap_t) {
-        c->cap_t = c->cap_t ? 2 * c->cap_t : 1024;
-        c->t = fs_realloc(c->t, (size_t)c->cap_t * sizeof *c->t);
-    }
+    FS_ARRAY_RESERVE(c->t, c->cap_t, c->n_t + 1, 1024);
     c->t[c->n_t++] = t;
 }
 
@@ -828,24 +821,6 @@ static int32_t split_columns(lift_ctx *c)
     return splits;
 }
 
-/* Union-find root with path halving. */
-static int32_t uf_find(int32_t *parent, int32_t i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
-static void uf_union(int32_t *parent, int32_t a, int32_t b)
-{
-    a = uf_find(parent, a);
-    b = uf_find(parent, b);
-    if (a != b)
-        parent[a < b ? b : a] = a < b ? a : b;
-}
-
 /* The corner of triangle f at position v (FS_ASSERT: there is one). */
 static int corner_at(const tri *f, int32_t v)
 {
@@ -889,8 +864,7 @@ static int32_t split_nonmanifold(lift_ctx *c)
     edges_build(&et, c->t, c->n_t);
     int32_t n_corner = 3 * c->n_t;
     int32_t *parent = fs_malloc(((size_t)n_corner + 1) * sizeof *parent);
-    for (int32_t i = 0; i < n_corner; i++)
-        parent[i] = i;
+    fs_uf_init(parent, n_corner);
     /* faces of the edges of more than two, as lists */
     int32_t *start = fs_calloc((size_t)et.n + 2, sizeof *start);
     int32_t n_bad = 0;
@@ -921,7 +895,7 @@ static int32_t split_nonmanifold(lift_ctx *c)
         if (er->count == 2) {
             for (int q = 0; q < 2; q++) {
                 int32_t v = q ? er->b : er->a;
-                uf_union(parent, 3 * er->face[0] + corner_at(c->t + er->face[0], v),
+                fs_uf_union(parent, 3 * er->face[0] + corner_at(c->t + er->face[0], v),
                          3 * er->face[1] + corner_at(c->t + er->face[1], v));
             }
             continue;
@@ -974,7 +948,7 @@ static int32_t split_nonmanifold(lift_ctx *c)
             int32_t j = ok ? (fan[i].front_ccw ? (i + m - 1) % m : (i + 1) % m) : 0;
             for (int q = 0; q < 2; q++) {
                 int32_t v = q ? er->b : er->a;
-                uf_union(parent, 3 * fan[i].face + corner_at(c->t + fan[i].face, v),
+                fs_uf_union(parent, 3 * fan[i].face + corner_at(c->t + fan[i].face, v),
                          3 * fan[j].face + corner_at(c->t + fan[j].face, v));
             }
         }
@@ -992,15 +966,15 @@ static int32_t split_nonmanifold(lift_ctx *c)
         owner[i] = -1;
     int32_t added = 0;
     for (int32_t i = 0; i < n_corner; i++) {
-        int32_t v = c->t[i / 3].pos[i % 3], root = uf_find(parent, i);
+        int32_t v = c->t[i / 3].pos[i % 3], root = fs_uf_find(parent, i);
         if (root == i) {
             if (owner[v] < 0) {
                 owner[v] = root;
                 group_pos[root] = v;
             } else {
-                if (c->pos.n == c->pos.cap) {
-                    c->pos.cap = 2 * c->pos.cap;
-                    c->pos.p = fs_realloc(c->pos.p, 3 * (size_t)c->pos.cap * sizeof *c->pos.p);
+                if (FS_ARRAY_GROW(c->pos.cap, c->pos.n + 1, 1024)) {
+                    FS_ARRAY_RESIZE(c->pos.p, 3 * (size_t)c->pos.cap);
+                    FS_ARRAY_RESIZE(c->pos.next, c->pos.cap);
                 }
                 memcpy(c->pos.p + 3 * (size_t)c->pos.n, c->pos.p + 3 * (size_t)v, 3 * sizeof *c->pos.p);
                 group_pos[root] = c->pos.n++;

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/vec.h"
@@ -44,13 +45,12 @@ static const double no_tangent[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
 static int32_t mesh_vertex(scene_mesh *m, const double *p, const double *n, double u, double v, const float *tint,
                            const double *tangent)
 {
-    if (m->n_verts == m->cap_verts) {
-        m->cap_verts = m->cap_verts ? 2 * m->cap_verts : 1024;
-        m->pos = fs_realloc(m->pos, 3 * (size_t)m->cap_verts * sizeof *m->pos);
-        m->normal = fs_realloc(m->normal, 3 * (size_t)m->cap_verts * sizeof *m->normal);
-        m->uv = fs_realloc(m->uv, 2 * (size_t)m->cap_verts * sizeof *m->uv);
-        m->tint = fs_realloc(m->tint, 4 * (size_t)m->cap_verts * sizeof *m->tint);
-        m->tangent = fs_realloc(m->tangent, 6 * (size_t)m->cap_verts * sizeof *m->tangent);
+    if (FS_ARRAY_GROW(m->cap_verts, m->n_verts + 1, 1024)) {
+        FS_ARRAY_RESIZE(m->pos, 3 * (size_t)m->cap_verts);
+        FS_ARRAY_RESIZE(m->normal, 3 * (size_t)m->cap_verts);
+        FS_ARRAY_RESIZE(m->uv, 2 * (size_t)m->cap_verts);
+        FS_ARRAY_RESIZE(m->tint, 4 * (size_t)m->cap_verts);
+        FS_ARRAY_RESIZE(m->tangent, 6 * (size_t)m->cap_verts);
     }
     int32_t i = m->n_verts++;
     for (int q = 0; q < 3; q++) {
@@ -67,10 +67,8 @@ static int32_t mesh_vertex(scene_mesh *m, const double *p, const double *n, doub
 
 static void mesh_tri(scene_mesh *m, int32_t a, int32_t b, int32_t c)
 {
-    if (m->n_tris == m->cap_tris) {
-        m->cap_tris = m->cap_tris ? 2 * m->cap_tris : 1024;
-        m->tri = fs_realloc(m->tri, 3 * (size_t)m->cap_tris * sizeof *m->tri);
-    }
+    if (FS_ARRAY_GROW(m->cap_tris, m->n_tris + 1, 1024))
+        FS_ARRAY_RESIZE(m->tri, 3 * (size_t)m->cap_tris);
     m->tri[3 * m->n_tris] = (uint32_t)a;
     m->tri[3 * m->n_tris + 1] = (uint32_t)b;
     m->tri[3 * m->n_tris + 2] = (uint32_t)c;

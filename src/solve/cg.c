@@ -1,4 +1,4 @@
-/* Jacobi-preconditioned conjugate gradients on an upper-triangle CSC matrix: the baseline beside CHOLMOD. */
+/* Preconditioned conjugate gradients on an operator, and on an upper-triangle CSC matrix with a Jacobi preconditioner: the baseline beside CHOLMOD. */
 #include "solve/cg.h"
 
 #include <float.h>
@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "base/error.h"
+#include "base/vec.h"
 
 fs_cg_params fs_cg_params_default(void)
 {
@@ -35,6 +36,95 @@ static double dot(int32_t n, const double *u, const double *v)
     return (s0 + s1) + (s2 + s3);
 }
 
+/* u . v in one running sum, in index order. */
+static double dot_sequential(int32_t n, const double *u, const double *v)
+{
+    double s = 0.0;
+    for (int32_t i = 0; i < n; i++)
+        s += u[i] * v[i];
+    return s;
+}
+
+double fs_cg_dot(int32_t n, const double *u, const double *v, fs_cg_sum sum)
+{
+    return sum == FS_CG_SUM_SEQUENTIAL ? dot_sequential(n, u, v) : dot(n, u, v);
+}
+
+/* r = b - A x, using q for A x. */
+static void residual(const fs_cg_operator *op, const double *b, const double *x, double *r, double *q)
+{
+    op->apply(op->ctx, x, q);
+    for (int32_t i = 0; i < op->n; i++)
+        r[i] = b[i] - q[i];
+}
+
+fs_pcg_result fs_pcg(const fs_cg_operator *op, const double *b, double *x, const fs_pcg_params *params,
+                     fs_pcg_vectors v)
+{
+    FS_ASSERT(params->max_iterations > 0);
+    int32_t n = op->n;
+    double *r = v.r, *z = v.z, *p = v.p, *q = v.q;
+    fs_pcg_result res = {FS_PCG_CONVERGED, 0, 0.0, 0.0};
+    if (params->from_zero) {
+        memset(x, 0, (size_t)n * sizeof *x);
+        memcpy(r, b, (size_t)n * sizeof *r);
+    } else {
+        residual(op, b, x, r, q);
+    }
+    if (params->true_residual && op->converged(op->ctx, r))
+        return res;
+    if (op->precondition(op->ctx, r, z) < 0) {
+        res.status = FS_PCG_FAILED;
+        return res;
+    }
+    double rz = fs_cg_dot(n, r, z, params->sum);
+    memcpy(p, z, (size_t)n * sizeof *p);
+    while (res.iterations < params->max_iterations) {
+        op->apply(op->ctx, p, q);
+        double curvature = fs_cg_dot(n, p, q, params->sum);
+        if (!(curvature > 0.0)) {
+            res.status = FS_PCG_BREAKDOWN;
+            res.curvature = curvature;
+            res.rz = rz;
+            return res;
+        }
+        double alpha = rz / curvature;
+        for (int32_t i = 0; i < n; i++) {
+            x[i] += alpha * p[i];
+            r[i] -= alpha * q[i];
+        }
+        res.iterations++;
+        if (op->converged(op->ctx, r)) {
+            if (!params->true_residual)
+                return res;
+            residual(op, b, x, r, q);
+            if (op->converged(op->ctx, r))
+                return res;
+            /* the recurrence drifted: restart the search from the true residual */
+            if (op->precondition(op->ctx, r, z) < 0) {
+                res.status = FS_PCG_FAILED;
+                return res;
+            }
+            rz = fs_cg_dot(n, r, z, params->sum);
+            memcpy(p, z, (size_t)n * sizeof *p);
+            continue;
+        }
+        if (res.iterations == params->max_iterations)
+            break;
+        if (op->precondition(op->ctx, r, z) < 0) {
+            res.status = FS_PCG_FAILED;
+            return res;
+        }
+        double rz_next = fs_cg_dot(n, r, z, params->sum);
+        double beta = rz_next / rz;
+        rz = rz_next;
+        for (int32_t i = 0; i < n; i++)
+            p[i] = z[i] + beta * p[i];
+    }
+    res.status = FS_PCG_MAX_ITERATIONS;
+    return res;
+}
+
 /* The largest |v[i]|, or NaN if an entry is not finite (so such a residual never passes a bound),
  * in four interleaved running maxima. */
 static double max_abs(int32_t n, const double *v)
@@ -58,13 +148,6 @@ static double max_abs(int32_t n, const double *v)
     m0 = m1 > m0 ? m1 : m0;
     m2 = m3 > m2 ? m3 : m2;
     return bad ? NAN : m2 > m0 ? m2 : m0;
-}
-
-/* The stopping rule: with a max_residual, every entry of r within it, else the Euclidean norm rnorm
- * within limit. */
-static bool converged(const fs_cg_params *params, int32_t n, const double *r, double rnorm, double limit)
-{
-    return params->max_residual > 0.0 ? max_abs(n, r) <= params->max_residual : rnorm <= limit;
 }
 
 /* design: with block = 3 the matrix is first copied into 3x3 blocks, one row of blocks per node
@@ -297,18 +380,9 @@ static void apply(const operator_t *op, const double *x, double *y)
         fs_sparse_matvec(op->a, x, y);
 }
 
-/* r = b - A x, using q as scratch; returns ||r||. */
-static double true_residual(const operator_t *op, int32_t n, const double *b, const double *x, double *r, double *q)
-{
-    apply(op, x, q);
-    for (int32_t i = 0; i < n; i++)
-        r[i] = b[i] - q[i];
-    return sqrt(dot(n, r, r));
-}
-
 /* z = M^-1 r with the preconditioner inv (block 1: n inverse diagonal entries; block 3: n / 3 inverse
- * 3x3 blocks, row-major); returns r'z. */
-static double precondition(int32_t n, int32_t block, const double *inv, const double *r, double *z)
+ * 3x3 blocks, row-major). */
+static void precondition(int32_t n, int32_t block, const double *inv, const double *r, double *z)
 {
     if (block == 3) {
         for (int32_t k = 0; k < n; k += 3) {
@@ -320,7 +394,6 @@ static double precondition(int32_t n, int32_t block, const double *inv, const do
         for (int32_t i = 0; i < n; i++)
             z[i] = inv[i] * r[i];
     }
-    return dot(n, r, z);
 }
 
 /* The preconditioner of fs_cg_solve (see precondition) into inv: the inverse diagonal of a, or the
@@ -349,26 +422,50 @@ static int preconditioner(const fs_sparse_matrix *a, const block3_matrix *blocks
     static const double zero[9] = {0};
     for (int32_t ib = 0; ib < blocks->nb; ib++) {
         const double *m = blocks->diag[ib] >= 0 ? blocks->v + 9 * (size_t)blocks->diag[ib] : zero;
-        /* the inverse by cofactors; positive definite iff the leading minors are positive */
-        double c00 = m[4] * m[8] - m[5] * m[7], c01 = m[5] * m[6] - m[3] * m[8], c02 = m[3] * m[7] - m[4] * m[6];
-        double det = m[0] * c00 + m[1] * c01 + m[2] * c02, minor2 = m[0] * m[4] - m[1] * m[3];
-        if (!(m[0] > 0.0 && minor2 > 0.0 && det > 0.0)) {
+        /* the inverse by cofactors; positive definite iff the leading minors (m[0], adj[8], det)
+         * are positive */
+        double adj[9], det = fs_mat3_adjugate(m, adj);
+        if (!(m[0] > 0.0 && adj[8] > 0.0 && det > 0.0)) {
             fs_error(FS_ERR_INTERNAL, "cg: diagonal block of unknowns %d-%d is not positive definite", 3 * ib,
                      3 * ib + 2);
             return -1;
         }
         double *v = inv + 9 * (size_t)ib;
-        v[0] = c00 / det, v[1] = (m[2] * m[7] - m[1] * m[8]) / det, v[2] = (m[1] * m[5] - m[2] * m[4]) / det;
-        v[3] = c01 / det, v[4] = (m[0] * m[8] - m[2] * m[6]) / det, v[5] = (m[2] * m[3] - m[0] * m[5]) / det;
-        v[6] = c02 / det, v[7] = (m[1] * m[6] - m[0] * m[7]) / det, v[8] = minor2 / det;
+        for (int k = 0; k < 9; k++)
+            v[k] = adj[k] / det;
     }
     return 0;
 }
 
-/* design: textbook preconditioned CG (Hestenes–Stiefel recurrences). The recurrence residual drifts from
- * the true one in floating point, so convergence is only accepted after recomputing b - A x; if that
- * fails, the search restarts from the true residual. */
-/* The iteration of fs_cg_solve on n unknowns with the matrix op (with blocks: params.block = 3). */
+/* fs_cg_solve's side of fs_pcg: the matrix, the preconditioner and the stopping rule. */
+typedef struct {
+    const operator_t *op;
+    int32_t n, block;
+    const double *inv;
+    const fs_cg_params *params;
+    double limit; /* tolerance ||b|| */
+} cg_ctx;
+
+static void cg_apply(void *ctx, const double *x, double *y) { apply(((const cg_ctx *)ctx)->op, x, y); }
+
+static int cg_precondition(void *ctx, const double *r, double *z)
+{
+    const cg_ctx *c = ctx;
+    precondition(c->n, c->block, c->inv, r, z);
+    return 0;
+}
+
+/* With a max_residual, every entry of r within it, else the Euclidean norm of r within limit. */
+static bool cg_converged(void *ctx, const double *r)
+{
+    const cg_ctx *c = ctx;
+    if (c->params->max_residual > 0.0)
+        return max_abs(c->n, r) <= c->params->max_residual;
+    return sqrt(dot(c->n, r, r)) <= c->limit;
+}
+
+/* fs_cg_solve on n unknowns with the matrix op (with blocks: params.block = 3): fs_pcg from x, on the
+ * true residual, with the interleaved sums. */
 static int cg_run(const operator_t *op, int32_t n, const double *b, double *x, fs_cg_params params,
                   double *relative_residual)
 {
@@ -383,66 +480,30 @@ static int cg_run(const operator_t *op, int32_t n, const double *b, double *x, f
     }
 
     int32_t block = op->b ? 3 : 1;
-    double *scratch = fs_malloc((3 + (size_t)block) * (size_t)n * sizeof *scratch);
-    double *r = scratch;
-    double *z = scratch + n;
-    double *p = scratch + 2 * (size_t)n;
-    double *inv = scratch + 3 * (size_t)n;
-    double *q = z; /* A p and the residual scratch share z's storage: each is dead before z is rewritten */
+    double *scratch = fs_malloc((4 + (size_t)block) * (size_t)n * sizeof *scratch);
+    fs_pcg_vectors v = {scratch, scratch + n, scratch + 2 * (size_t)n, scratch + 3 * (size_t)n};
+    double *inv = scratch + 4 * (size_t)n;
     int status = -1;
     if (preconditioner(op->a, op->b, inv) < 0)
         goto done;
-
-    /* with the max_residual rule the Euclidean norm is only needed for the report */
-    bool by_max = params.max_residual > 0.0;
-    double limit = params.tolerance * bnorm;
-    double rnorm = true_residual(op, n, b, x, r, q);
-    int32_t iterations = 0;
-    if (!converged(&params, n, r, rnorm, limit)) {
-        double rz = precondition(n, block, inv, r, z);
-        for (int32_t i = 0; i < n; i++)
-            p[i] = z[i];
-        while (iterations < max_iterations) {
-            apply(op, p, q);
-            double curvature = dot(n, p, q);
-            if (!(curvature > 0.0)) {
-                fs_error(FS_ERR_INTERNAL, "cg: matrix not positive definite (p'Ap = %g at iteration %d)",
-                         curvature, iterations);
-                goto done;
-            }
-            double alpha = rz / curvature;
-            for (int32_t i = 0; i < n; i++) {
-                x[i] += alpha * p[i];
-                r[i] -= alpha * q[i];
-            }
-            iterations++;
-            rnorm = by_max ? NAN : sqrt(dot(n, r, r));
-            if (converged(&params, n, r, rnorm, limit)) {
-                rnorm = true_residual(op, n, b, x, r, q);
-                if (converged(&params, n, r, rnorm, limit))
-                    break;
-                rz = precondition(n, block, inv, r, z);
-                for (int32_t i = 0; i < n; i++)
-                    p[i] = z[i];
-                continue;
-            }
-            double rz_next = precondition(n, block, inv, r, z);
-            double beta = rz_next / rz;
-            rz = rz_next;
-            for (int32_t i = 0; i < n; i++)
-                p[i] = z[i] + beta * p[i];
-        }
+    cg_ctx c = {op, n, block, inv, &params, params.tolerance * bnorm};
+    fs_cg_operator a = {n, cg_apply, cg_precondition, cg_converged, &c};
+    fs_pcg_params pcg = {max_iterations, FS_CG_SUM_INTERLEAVED, false, true};
+    fs_pcg_result res = fs_pcg(&a, b, x, &pcg, v);
+    if (res.status == FS_PCG_BREAKDOWN) {
+        fs_error(FS_ERR_INTERNAL, "cg: matrix not positive definite (p'Ap = %g at iteration %d)", res.curvature,
+                 res.iterations);
+        goto done;
     }
-    if (by_max && isnan(rnorm))
-        rnorm = sqrt(dot(n, r, r));
+    double rnorm = sqrt(dot(n, v.r, v.r));
     if (relative_residual)
         *relative_residual = rnorm / bnorm;
-    if (!converged(&params, n, r, rnorm, limit)) {
-        fs_error(FS_ERR_INTERNAL, "cg: no convergence after %d iterations (relative residual %.3g)", iterations,
+    if (res.status != FS_PCG_CONVERGED) {
+        fs_error(FS_ERR_INTERNAL, "cg: no convergence after %d iterations (relative residual %.3g)", res.iterations,
                  rnorm / bnorm);
         goto done;
     }
-    status = iterations;
+    status = res.iterations;
 done:
     free(scratch);
     return status;

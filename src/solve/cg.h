@@ -1,10 +1,81 @@
-/* Jacobi-preconditioned conjugate gradients: the iterative baseline for the equilibrium solves (thesis §5.4). */
+/* Preconditioned conjugate gradients on an operator, and the Jacobi-preconditioned matrix CG built on it: the iterative baseline for the equilibrium solves (thesis §5.4). */
 #ifndef FS_SOLVE_CG_H
 #define FS_SOLVE_CG_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "solve/sparse.h"
+
+/* ---- conjugate gradients on an operator ---- */
+
+/* How fs_pcg adds up its dot products. Both are fixed orders, so both are deterministic; they round
+ * differently, so a caller keeps the one its results were made with. */
+typedef enum {
+    FS_CG_SUM_INTERLEAVED = 0, /* four interleaved partial sums, added pairwise at the end (the additions
+                                  of one running sum would wait on each other) */
+    FS_CG_SUM_SEQUENTIAL       /* one running sum in index order */
+} fs_cg_sum;
+
+/* A symmetric positive definite operator A on n unknowns, its preconditioner M^-1 and the stopping
+ * rule, as callbacks on the caller's ctx. */
+typedef struct {
+    int32_t n;
+    void (*apply)(void *ctx, const double *x, double *y);       /* y = A x (every entry written) */
+    int (*precondition)(void *ctx, const double *r, double *z); /* z = M^-1 r (M symmetric positive
+                                                                   definite): 0, or -1 with fs_error */
+    bool (*converged)(void *ctx, const double *r);              /* whether residual r is small enough */
+    void *ctx;
+} fs_cg_operator;
+
+/* How fs_pcg starts and judges convergence. */
+typedef struct {
+    int32_t max_iterations; /* updates of x at most (> 0) */
+    fs_cg_sum sum;
+    bool from_zero;         /* start from x = 0 with r = b, without a product (x's content on entry is
+                               ignored); else from x as given, r = b - A x */
+    bool true_residual;     /* judge convergence on b - A x: stop before the first iteration if the
+                               starting residual passes, and when the recurrence's residual passes,
+                               recompute r = b - A x and accept only if that passes too (else the search
+                               restarts from it, p = M^-1 r); without it the recurrence's r decides */
+} fs_pcg_params;
+
+typedef enum {
+    FS_PCG_CONVERGED = 0,  /* op->converged accepted the residual */
+    FS_PCG_MAX_ITERATIONS, /* max_iterations done without that */
+    FS_PCG_BREAKDOWN,      /* a search direction with p'Ap <= 0 (or NaN): A is not positive definite,
+                              or the residual was already zero to rounding (see rz) */
+    FS_PCG_FAILED          /* the preconditioner failed (its fs_error is kept) */
+} fs_pcg_status;
+
+typedef struct {
+    fs_pcg_status status;
+    int32_t iterations;    /* updates of x made */
+    double curvature;      /* at a breakdown: the p'Ap found */
+    double rz;             /* at a breakdown: r'z of the current residual (0: nothing left to reduce) */
+} fs_pcg_result;
+
+/* The caller's vectors of n doubles each for fs_pcg: on return r holds the last residual (the true
+ * one after a convergence with true_residual); z, p and q are scratch. None may overlap b or x. */
+typedef struct {
+    double *r, *z, *p, *q;
+} fs_pcg_vectors;
+
+/* design: textbook preconditioned CG (Hestenes–Stiefel recurrences):
+ *     r = b - A x, z = M^-1 r, p = z; repeat: q = A p, alpha = r'z / p'q, x += alpha p, r -= alpha q,
+ *     stop if converged(r), z = M^-1 r, beta = r'z (new) / r'z (old), p = z + beta p.
+ * Every vector operation runs in index order and every dot product in the order params.sum names,
+ * so the iterates are the same bit for bit on every run and machine (-ffp-contract=off). The
+ * recurrence residual drifts from the true one in floating point; true_residual guards against
+ * that at the cost of a product per claimed convergence.
+ * Solves A x = b into x. Returns the status and the iterations; never calls fs_error itself. */
+fs_pcg_result fs_pcg(const fs_cg_operator *op, const double *b, double *x, const fs_pcg_params *params,
+                     fs_pcg_vectors v);
+
+/* u . v over n entries, summed as sum says (what fs_pcg's dot products are). */
+double fs_cg_dot(int32_t n, const double *u, const double *v, fs_cg_sum sum);
+
+/* ---- the matrix CG ---- */
 
 /* Stopping rule of fs_cg_solve. */
 typedef struct {

@@ -8,6 +8,7 @@
 #include <cholmod.h>
 #include <dlfcn.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/threads.h"
@@ -37,15 +38,11 @@ void fs_sparse_builder_clear(fs_sparse_builder *b) { b->count = 0; }
 
 static void builder_reserve(fs_sparse_builder *b, size_t extra)
 {
-    if (b->count + extra <= b->capacity)
-        return;
-    size_t capacity = b->capacity ? b->capacity : 64;
-    while (capacity < b->count + extra)
-        capacity *= 2;
-    b->rows = fs_realloc(b->rows, capacity * sizeof *b->rows);
-    b->cols = fs_realloc(b->cols, capacity * sizeof *b->cols);
-    b->values = fs_realloc(b->values, capacity * sizeof *b->values);
-    b->capacity = capacity;
+    if (FS_ARRAY_GROW(b->capacity, b->count + extra, 64)) {
+        FS_ARRAY_RESIZE(b->rows, b->capacity);
+        FS_ARRAY_RESIZE(b->cols, b->capacity);
+        FS_ARRAY_RESIZE(b->values, b->capacity);
+    }
 }
 
 size_t fs_sparse_builder_add(fs_sparse_builder *b, int32_t row, int32_t col, double value)

@@ -5,8 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/vec.h"
+#include "solve/cg.h"
 
 /* ==== the generic network ==== */
 
@@ -402,49 +404,46 @@ static void net_step(const fs_spring_net *net, const double *x, const double *p,
     }
 }
 
+/* The tangent K and the factor M of an earlier one as fs_pcg's operator (solve/cg.h). */
+typedef struct {
+    fs_spring_net *net;
+    double target; /* of the Euclidean norm of the residual */
+} net_pcg_ctx;
+
+static void net_pcg_apply(void *ctx, const double *x, double *y)
+{
+    fs_sparse_matvec(&((net_pcg_ctx *)ctx)->net->K, x, y);
+}
+
+static int net_pcg_precondition(void *ctx, const double *r, double *z) { return net_solve(((net_pcg_ctx *)ctx)->net, r, z); }
+
+static bool net_pcg_converged(void *ctx, const double *r)
+{
+    const net_pcg_ctx *c = ctx;
+    return sqrt(fs_cg_dot(c->net->n_dof, r, r, FS_CG_SUM_SEQUENTIAL)) <= c->target;
+}
+
 /* Solves K p = f (K assembled at the current state) by conjugate gradients preconditioned with the
- * factor M, until ||K p - f|| <= target or max_it iterations. Returns the iterations used, max_it + 1
- * if not converged, -1 on a solver failure. r, z, d, q are n_dof scratch vectors. */
+ * factor M (fs_pcg from p = 0, sequential sums), until ||K p - f|| <= target or max_it iterations.
+ * Returns the iterations used, max_it + 1 if not converged (or a direction of no curvature after the
+ * first), -1 on a solver failure. r, z, d, q are n_dof scratch vectors. */
 static int net_pcg(fs_spring_net *net, const double *f, double *p, double target, int max_it, double *r, double *z,
                    double *d, double *q)
 {
-    int32_t nd = net->n_dof;
-    memset(p, 0, (size_t)nd * sizeof *p);
-    memcpy(r, f, (size_t)nd * sizeof *r);
-    if (net_solve(net, r, z) < 0)
+    net_pcg_ctx c = {net, target};
+    fs_cg_operator k = {net->n_dof, net_pcg_apply, net_pcg_precondition, net_pcg_converged, &c};
+    fs_pcg_params params = {max_it, FS_CG_SUM_SEQUENTIAL, true, false};
+    fs_pcg_result res = fs_pcg(&k, f, p, &params, (fs_pcg_vectors){r, z, d, q});
+    switch (res.status) {
+    case FS_PCG_CONVERGED:
+        return res.iterations;
+    case FS_PCG_BREAKDOWN:
+        return res.iterations == 0 ? -1 : max_it + 1;
+    case FS_PCG_MAX_ITERATIONS:
+        return max_it + 1;
+    default:
         return -1;
-    double rz = 0.0;
-    for (int32_t j = 0; j < nd; j++)
-        rz += r[j] * z[j];
-    memcpy(d, z, (size_t)nd * sizeof *d);
-    for (int it = 1; it <= max_it; it++) {
-        fs_sparse_matvec(&net->K, d, q);
-        double dq = 0.0;
-        for (int32_t j = 0; j < nd; j++)
-            dq += d[j] * q[j];
-        if (!(dq > 0.0))
-            return it == 1 ? -1 : max_it + 1;
-        double alpha = rz / dq, rr = 0.0;
-        for (int32_t j = 0; j < nd; j++) {
-            p[j] += alpha * d[j];
-            r[j] -= alpha * q[j];
-            rr += r[j] * r[j];
-        }
-        if (sqrt(rr) <= target)
-            return it;
-        if (it == max_it)
-            break;
-        if (net_solve(net, r, z) < 0)
-            return -1;
-        double rz_new = 0.0;
-        for (int32_t j = 0; j < nd; j++)
-            rz_new += r[j] * z[j];
-        double beta = rz_new / rz;
-        rz = rz_new;
-        for (int32_t j = 0; j < nd; j++)
-            d[j] = z[j] + beta * d[j];
     }
-    return max_it + 1;
 }
 
 /* design: inexact Newton. Each step assembles the tangent K at the current positions and solves
@@ -664,10 +663,9 @@ static void region_clear(fs_spring_net *net, local_region *g)
 
 static void region_push(fs_spring_net *net, local_region *g, int32_t node, int32_t depth)
 {
-    if (g->n == g->cap) {
-        g->cap = g->cap ? 2 * g->cap : 256;
-        g->nodes = fs_realloc(g->nodes, (size_t)g->cap * sizeof *g->nodes);
-        g->depth = fs_realloc(g->depth, (size_t)g->cap * sizeof *g->depth);
+    if (FS_ARRAY_GROW(g->cap, g->n + 1, 256)) {
+        FS_ARRAY_RESIZE(g->nodes, g->cap);
+        FS_ARRAY_RESIZE(g->depth, g->cap);
     }
     net->local_map[node] = g->n;
     g->nodes[g->n] = node;
@@ -704,10 +702,7 @@ static void region_grow(fs_spring_net *net, local_region *g, const int32_t *seed
             int32_t other = a == i ? b : a;
             if (net->local_map[other] >= 0 && a != i)
                 continue; /* both ends inside: counted from its first end */
-            if (g->ns == g->cap_s) {
-                g->cap_s = g->cap_s ? 2 * g->cap_s : 1024;
-                g->springs = fs_realloc(g->springs, (size_t)g->cap_s * sizeof *g->springs);
-            }
+            FS_ARRAY_RESERVE(g->springs, g->cap_s, g->ns + 1, 1024);
             g->springs[g->ns++] = s;
         }
     }
@@ -833,19 +828,7 @@ static void invert_block(double *A, int dim)
         A[2] = -A[2] / det;
         return;
     }
-    double c[9];
-    c[0] = A[4] * A[8] - A[5] * A[7];
-    c[1] = A[2] * A[7] - A[1] * A[8];
-    c[2] = A[1] * A[5] - A[2] * A[4];
-    c[3] = A[5] * A[6] - A[3] * A[8];
-    c[4] = A[0] * A[8] - A[2] * A[6];
-    c[5] = A[2] * A[3] - A[0] * A[5];
-    c[6] = A[3] * A[7] - A[4] * A[6];
-    c[7] = A[1] * A[6] - A[0] * A[7];
-    c[8] = A[0] * A[4] - A[1] * A[3];
-    double det = A[0] * c[0] + A[1] * c[3] + A[2] * c[6];
-    for (int m = 0; m < 9; m++)
-        A[m] = c[m] / det;
+    fs_mat3_inverse(A, A);
 }
 
 /* y = K_RR v over the region (nodes outside held: their v is 0); D holds the diagonal blocks (springs,
@@ -894,18 +877,27 @@ static double region_max(const local_region *g, const double *v, int dim)
     return worst;
 }
 
-/* Solves K_RR p = f by block-Jacobi preconditioned CG until the largest node residual is below
- * target. D holds the diagonal blocks, g->P their inverses. Returns the iterations, or -1. */
-static int region_cg(const fs_spring_net *net, local_region *g, const double *D, double target)
+/* The region's K_RR and its block-Jacobi preconditioner as fs_pcg's operator (solve/cg.h). */
+typedef struct {
+    const fs_spring_net *net;
+    const local_region *g;
+    const double *D;  /* the diagonal blocks (g->P holds their inverses) */
+    double target;    /* of the largest node residual */
+} region_pcg_ctx;
+
+static void region_pcg_apply(void *ctx, const double *x, double *y)
 {
-    int dim = net->dim, dd = dim * dim;
-    size_t nv = (size_t)g->n * (size_t)dim;
-    memset(g->p, 0, nv * sizeof *g->p);
-    memcpy(g->r, g->f, nv * sizeof *g->r);
-    double rz = 0.0;
-    for (int32_t k = 0; k < g->n; k++) {
-        const double *P = g->P + (size_t)dd * (size_t)k, *rk = g->r + (size_t)dim * (size_t)k;
-        double *zk = g->z + (size_t)dim * (size_t)k;
+    const region_pcg_ctx *c = ctx;
+    region_apply(c->net, c->g, c->D, x, y);
+}
+
+static int region_pcg_precondition(void *ctx, const double *r, double *z)
+{
+    const region_pcg_ctx *c = ctx;
+    int dim = c->net->dim, dd = dim * dim;
+    for (int32_t k = 0; k < c->g->n; k++) {
+        const double *P = c->g->P + (size_t)dd * (size_t)k, *rk = r + (size_t)dim * (size_t)k;
+        double *zk = z + (size_t)dim * (size_t)k;
         for (int p = 0; p < dim; p++) {
             double acc = 0.0;
             for (int q = 0; q < dim; q++)
@@ -913,42 +905,28 @@ static int region_cg(const fs_spring_net *net, local_region *g, const double *D,
             zk[p] = acc;
         }
     }
-    for (size_t m = 0; m < nv; m++)
-        rz += g->r[m] * g->z[m];
-    memcpy(g->d, g->z, nv * sizeof *g->d);
-    int max_it = 50 + 10 * (int)sqrt((double)g->n) + 2000;
-    for (int it = 1; it <= max_it; it++) {
-        region_apply(net, g, D, g->d, g->q);
-        double dq = 0.0;
-        for (size_t m = 0; m < nv; m++)
-            dq += g->d[m] * g->q[m];
-        if (!(dq > 0.0))
-            return rz == 0.0 ? it : -1;
-        double alpha = rz / dq;
-        for (size_t m = 0; m < nv; m++) {
-            g->p[m] += alpha * g->d[m];
-            g->r[m] -= alpha * g->q[m];
-        }
-        if (region_max(g, g->r, dim) <= target)
-            return it;
-        double rz_new = 0.0;
-        for (int32_t k = 0; k < g->n; k++) {
-            const double *P = g->P + (size_t)dd * (size_t)k, *rk = g->r + (size_t)dim * (size_t)k;
-            double *zk = g->z + (size_t)dim * (size_t)k;
-            for (int p = 0; p < dim; p++) {
-                double acc = 0.0;
-                for (int q = 0; q < dim; q++)
-                    acc += P[p * dim + q] * rk[q];
-                zk[p] = acc;
-            }
-        }
-        for (size_t m = 0; m < nv; m++)
-            rz_new += g->r[m] * g->z[m];
-        double beta = rz_new / rz;
-        rz = rz_new;
-        for (size_t m = 0; m < nv; m++)
-            g->d[m] = g->z[m] + beta * g->d[m];
-    }
+    return 0;
+}
+
+static bool region_pcg_converged(void *ctx, const double *r)
+{
+    const region_pcg_ctx *c = ctx;
+    return region_max(c->g, r, c->net->dim) <= c->target;
+}
+
+/* Solves K_RR p = f by block-Jacobi preconditioned CG (fs_pcg from p = 0, sequential sums) until the
+ * largest node residual is below target. D holds the diagonal blocks, g->P their inverses. Returns
+ * the iterations (a direction of no curvature with nothing left to reduce counts as converged), or -1. */
+static int region_cg(const fs_spring_net *net, local_region *g, const double *D, double target)
+{
+    region_pcg_ctx c = {net, g, D, target};
+    fs_cg_operator k = {g->n * net->dim, region_pcg_apply, region_pcg_precondition, region_pcg_converged, &c};
+    fs_pcg_params params = {50 + 10 * (int)sqrt((double)g->n) + 2000, FS_CG_SUM_SEQUENTIAL, true, false};
+    fs_pcg_result res = fs_pcg(&k, g->f, g->p, &params, (fs_pcg_vectors){g->r, g->z, g->d, g->q});
+    if (res.status == FS_PCG_CONVERGED)
+        return res.iterations;
+    if (res.status == FS_PCG_BREAKDOWN && res.rz == 0.0)
+        return res.iterations + 1;
     return -1;
 }
 

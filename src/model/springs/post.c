@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/rng.h"
@@ -468,11 +469,10 @@ static void lift(const post_ctx *c, const double *base, double z, double *out)
 
 static int32_t add_post_node(post_ctx *c, int32_t *cap, int level, const double *init, const double *ref)
 {
-    if (c->n_post == *cap) {
-        *cap = *cap ? 2 * *cap : 1024;
-        c->init = fs_realloc(c->init, 3 * (size_t)*cap * sizeof *c->init);
-        c->refp = fs_realloc(c->refp, 3 * (size_t)*cap * sizeof *c->refp);
-        c->post_level = fs_realloc(c->post_level, (size_t)*cap);
+    if (FS_ARRAY_GROW(*cap, c->n_post + 1, 1024)) {
+        FS_ARRAY_RESIZE(c->init, 3 * (size_t)*cap);
+        FS_ARRAY_RESIZE(c->refp, 3 * (size_t)*cap);
+        FS_ARRAY_RESIZE(c->post_level, *cap);
     }
     int32_t id = c->n_post++;
     memcpy(c->init + 3 * (size_t)id, init, 3 * sizeof *init);
@@ -573,10 +573,7 @@ static void push_spring(const post_ctx *c, spring_list *list, int32_t a, const d
 {
     if (a == b)
         return;
-    if (list->n == list->cap) {
-        list->cap = list->cap ? 2 * list->cap : 4096;
-        list->v = fs_realloc(list->v, (size_t)list->cap * sizeof *list->v);
-    }
+    FS_ARRAY_RESERVE(list->v, list->cap, list->n + 1, 4096);
     post_spring *sp = list->v + list->n;
     sp->a = a;
     sp->b = b;

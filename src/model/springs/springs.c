@@ -5,9 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/rng.h"
+#include "base/uf.h"
 #include "base/vec.h"
 #include "fracture/event.h"
 #include "fracture/rank.h"
@@ -239,33 +241,19 @@ void fs_springs_direction(const fs_springs *s, int32_t spring, double dir[3])
         dir[q] = l > 0.0 ? d[q] / l : 0.0;
 }
 
-static int32_t uf_find(int32_t *parent, int32_t i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
 int32_t fs_springs_fragments(const fs_springs *s, int32_t *label)
 {
     int32_t n = s->n;
-    for (int32_t i = 0; i < n; i++)
-        label[i] = i;
+    fs_uf_init(label, n);
     int32_t base = (s->layers - 1) * s->n_edges;
     for (int32_t e = 0; e < s->n_edges; e++) {
         if (s->broken[base + e])
             continue;
-        int32_t a = uf_find(label, s->mesh->edge[2 * e]), b = uf_find(label, s->mesh->edge[2 * e + 1]);
-        if (a < b)
-            label[b] = a;
-        else if (b < a)
-            label[a] = b;
+        fs_uf_union(label, s->mesh->edge[2 * e], s->mesh->edge[2 * e + 1]);
     }
     int32_t count = 0;
     for (int32_t i = 0; i < n; i++) {
-        label[i] = uf_find(label, i);
+        label[i] = fs_uf_find(label, i);
         count += label[i] == i;
     }
     return count;
@@ -485,10 +473,7 @@ static int cascade(fs_springs *s)
         int32_t pick = fs_rank_pick(s->ratio, NULL, s->n_material, s->setup.seed);
         if (pick < 0 || !(s->ratio[pick] > 1.0))
             return 0;
-        if (s->break_count == s->break_capacity) {
-            s->break_capacity = s->break_capacity ? 2 * s->break_capacity : 256;
-            s->breaks = fs_realloc(s->breaks, (size_t)s->break_capacity * sizeof *s->breaks);
-        }
+        FS_ARRAY_RESERVE(s->breaks, s->break_capacity, s->break_count + 1, 256);
         fs_springs_break *b = s->breaks + s->break_count++;
         b->spring = pick;
         b->time = s->time;

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/rng.h"
 #include "fracture/event.h"
@@ -188,10 +189,7 @@ static double event_ratio(void *ctx, double t)
 
 static void record_break(fs_springs1d *s, int32_t j)
 {
-    if (s->break_count == s->break_capacity) {
-        s->break_capacity = s->break_capacity ? 2 * s->break_capacity : 16;
-        s->breaks = fs_realloc(s->breaks, (size_t)s->break_capacity * sizeof *s->breaks);
-    }
+    FS_ARRAY_RESERVE(s->breaks, s->break_capacity, s->break_count + 1, 16);
     fs_springs1d_break *b = &s->breaks[s->break_count++];
     b->time = s->time;
     b->x = ((double)j + 0.5) * s->spacing;

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/sort.h"
@@ -40,10 +41,7 @@ static bool heap_less(heap_item x, heap_item y)
 
 static void heap_push(heap *h, double d, int32_t node)
 {
-    if (h->n == h->cap) {
-        h->cap = h->cap ? 2 * h->cap : 256;
-        h->a = fs_realloc(h->a, (size_t)h->cap * sizeof *h->a);
-    }
+    FS_ARRAY_RESERVE(h->a, h->cap, h->n + 1, 256);
     int32_t i = h->n++;
     heap_item it = {d, node};
     while (i > 0 && heap_less(it, h->a[(i - 1) / 2])) {

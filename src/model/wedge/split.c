@@ -3,11 +3,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
+#include "base/uf.h"
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "fracture/rank.h"
 #include "fracture/split.h"
+#include "geom/cut.h"
 #include "geom/refine.h"
 #include "model/wedge/internal.h"
 #include "model/wedge/frame.h"
@@ -350,11 +353,10 @@ static void tip_add(fs_wedge_model *w, int32_t node, const double dir[3])
 {
     if (tip_find(w, node) >= 0)
         return;
-    if (w->n_tips == w->cap_tips) {
-        w->cap_tips = w->cap_tips ? 2 * w->cap_tips : 16;
-        w->tip_node = fs_realloc(w->tip_node, (size_t)w->cap_tips * sizeof *w->tip_node);
-        w->tip_dir = fs_realloc(w->tip_dir, 3 * (size_t)w->cap_tips * sizeof *w->tip_dir);
-        w->tip_scale = fs_realloc(w->tip_scale, (size_t)w->cap_tips * sizeof *w->tip_scale);
+    if (FS_ARRAY_GROW(w->cap_tips, w->n_tips + 1, 16)) {
+        FS_ARRAY_RESIZE(w->tip_node, w->cap_tips);
+        FS_ARRAY_RESIZE(w->tip_dir, 3 * (size_t)w->cap_tips);
+        FS_ARRAY_RESIZE(w->tip_scale, w->cap_tips);
     }
     w->tip_node[w->n_tips] = node;
     w->tip_scale[w->n_tips] = 1.0;
@@ -371,126 +373,33 @@ typedef struct {
 
 static void ilist_push(ilist *l, int32_t x)
 {
-    if (l->n == l->cap) {
-        l->cap = l->cap ? 2 * l->cap : 16;
-        l->v = fs_realloc(l->v, (size_t)l->cap * sizeof *l->v);
-    }
+    FS_ARRAY_RESERVE(l->v, l->cap, l->n + 1, 16);
     l->v[l->n++] = x;
 }
 
-/* ---- the cut ---- */
+/* ---- the cut (the mesh surgery itself is geom/cut.h's) ---- */
 
-/* Bookkeeping of one cut, in the terms of fs_wedge_change. */
+/* One cut: the mesh surgery's record, and the model it changes. */
 typedef struct {
+    fs_cut cut;
     fs_wedge_model *w;
-    int32_t n_nodes0, n_tris0;
-    ilist node_parent;   /* 2 per new node */
-    double *node_weight; /* per new node */
-    ilist tri_parent;    /* per new triangle */
-    uint8_t *changed;    /* per pre-cut triangle */
-    ilist changed_list;  /* the pre-cut triangles flagged in changed */
-    int32_t n_tris_adj;  /* triangles the adjacency was last brought up to date for */
 } cut_state;
 
-static void mark_changed(cut_state *cs, int32_t t)
+/* fs_cut_tris_fn of the wedge model: the living elements at node i in the mesh as the cut has changed
+ * it so far, from node_elem and the cut's changed and new triangles (fs_wedge_elems_at). */
+static int32_t wedge_tris_at(void *ctx, const fs_cut *cut, int32_t i, int32_t **out, int32_t *cap)
 {
-    if (t < cs->n_tris0 && !cs->changed[t]) {
-        cs->changed[t] = 1;
-        ilist_push(&cs->changed_list, t);
-    }
-}
-
-static void cut_free(cut_state *cs)
-{
-    free(cs->changed);
-    free(cs->changed_list.v);
-    free(cs->node_parent.v);
-    free(cs->tri_parent.v);
-    free(cs->node_weight);
-}
-
-/* The mesh's adjacency after the changes of the cut so far (fs_mesh_update_adjacency: the cost is
- * that of the changed triangles): every triangle the cut changed or made is listed, those made since
- * the last update as new. */
-static int update_adjacency(cut_state *cs)
-{
-    fs_mesh *m = cs->w->mesh;
-    ilist list = {0};
-    for (int32_t q = 0; q < cs->changed_list.n; q++)
-        ilist_push(&list, cs->changed_list.v[q]);
-    for (int32_t t = cs->n_tris0; t < cs->n_tris_adj; t++)
-        ilist_push(&list, t);
-    int rc = fs_mesh_update_adjacency(m, cs->n_tris_adj, list.v, list.n);
-    cs->n_tris_adj = m->n_tris;
-    free(list.v);
-    return rc;
-}
-
-static int32_t new_node(cut_state *cs, const double pos[3], int32_t a, int32_t b, double s)
-{
-    fs_mesh *m = cs->w->mesh;
-    double p[3] = {pos[0], pos[1], pos[2]}; /* pos may point into m->pos, which moves */
-    int32_t i = m->n_nodes++;
-    m->pos = fs_realloc(m->pos, 3 * (size_t)m->n_nodes * sizeof *m->pos);
-    memcpy(m->pos + 3 * (size_t)i, p, sizeof p);
-    ilist_push(&cs->node_parent, a);
-    ilist_push(&cs->node_parent, b);
-    int32_t k = i - cs->n_nodes0;
-    cs->node_weight = fs_realloc(cs->node_weight, ((size_t)k + 1) * sizeof *cs->node_weight);
-    cs->node_weight[k] = s;
-    return i;
-}
-
-static int32_t new_tri(cut_state *cs, int32_t parent)
-{
-    fs_mesh *m = cs->w->mesh;
-    int32_t t = m->n_tris++;
-    m->tri = fs_realloc(m->tri, 3 * (size_t)m->n_tris * sizeof *m->tri);
-    memcpy(m->tri + 3 * (size_t)t, m->tri + 3 * (size_t)parent, 3 * sizeof *m->tri);
-    if (m->shift) {
-        m->shift = fs_realloc(m->shift, 6 * (size_t)m->n_tris * sizeof *m->shift);
-        memcpy(m->shift + 6 * (size_t)t, m->shift + 6 * (size_t)parent, 6 * sizeof *m->shift);
-    }
-    ilist_push(&cs->tri_parent, parent < cs->n_tris0 ? parent : cs->tri_parent.v[parent - cs->n_tris0]);
-    return t;
-}
-
-/* Shifts of triangle t renormalised so that its first corner has shift (0, 0). */
-static void normalize_shifts(fs_mesh *m, int32_t t)
-{
-    if (!m->shift)
-        return;
-    int8_t *s = m->shift + 6 * (size_t)t;
-    int8_t s0 = s[0], s1 = s[1];
-    for (int c = 0; c < 3; c++) {
-        s[2 * c] = (int8_t)(s[2 * c] - s0);
-        s[2 * c + 1] = (int8_t)(s[2 * c + 1] - s1);
-    }
-}
-
-/* Sets corner c of triangle t to node i, whose unwrapped position in t's frame is p. */
-static void set_corner(fs_mesh *m, int32_t t, int c, int32_t i, const double p[3])
-{
-    m->tri[3 * (size_t)t + c] = i;
-    if (!m->shift)
-        return;
-    const double *q = m->pos + 3 * (size_t)i;
-    double ex = fs_domain_extent_x(&m->domain), ey = fs_domain_extent_y(&m->domain);
-    m->shift[6 * (size_t)t + 2 * c] = (int8_t)lround((p[0] - q[0]) / ex);
-    m->shift[6 * (size_t)t + 2 * c + 1] = (int8_t)lround((p[1] - q[1]) / ey);
+    const fs_wedge_model *w = ctx;
+    int32_t room = (i < w->n_nodes ? w->node_elem_count[i] : 0) + cut->n_changed + (w->mesh->n_tris - cut->n_tris_before);
+    FS_ARRAY_RESERVE(*out, *cap, room, 16);
+    return fs_wedge_elems_at(w, i, cut->changed_list, cut->n_changed, cut->n_tris_before, true, *out);
 }
 
 /* Living triangles that have node i as a corner, ascending, in the mesh as the cut has changed it so
- * far (every corner the cut rewrites is in a changed or new triangle). */
+ * far, into the list out. */
 static void tris_at(const cut_state *cs, int32_t i, ilist *out)
 {
-    const fs_wedge_model *w = cs->w;
-    int32_t room = (i < w->n_nodes ? w->node_elem_count[i] : 0) + cs->changed_list.n + (w->mesh->n_tris - cs->n_tris0);
-    if (out->cap < room) {
-        out->cap = room;
-        out->v = fs_realloc(out->v, (size_t)out->cap * sizeof *out->v);
-    }
-    out->n = fs_wedge_elems_at(w, i, cs->changed_list.v, cs->changed_list.n, cs->n_tris0, true, out->v);
+    out->n = fs_cut_tris_at(&cs->cut, i, &out->v, &out->cap);
 }
 
 /* Corner c of triangle t relative to corner cn, in the 2-D frame. */
@@ -501,48 +410,6 @@ static void rel_2d(const fs_mesh *m, const fs_wedge_frame *f, int32_t t, int cn,
     fs_mesh_corner(m, t, c, b);
     fs_sub3(d, b, a);
     fs_wedge_frame_to_2d(f, d, out);
-}
-
-/* Splits edge ab (corners ia, ib = ia + 1 of triangle t) at a + s (b - a), and the neighbour across
- * it. Returns the new node. t keeps (.., a, p, ..) and a new triangle gets (.., p, b, ..); likewise the
- * neighbour. */
-static int32_t split_edge(cut_state *cs, int32_t t, int ia, double s)
-{
-    fs_mesh *m = cs->w->mesh;
-    int ib = (ia + 1) % 3;
-    int32_t a = m->tri[3 * (size_t)t + ia], b = m->tri[3 * (size_t)t + ib];
-    int32_t u = m->adj[3 * (size_t)t + ia];
-    double pa[3], pb[3], p[3], q[3];
-    fs_mesh_corner(m, t, ia, pa);
-    fs_mesh_corner(m, t, ib, pb);
-    for (int k = 0; k < 3; k++)
-        p[k] = pa[k] + s * (pb[k] - pa[k]);
-    memcpy(q, p, sizeof q);
-    fs_domain_wrap(&m->domain, q);
-    if (!cs->w->flat)
-        memcpy(p, q, sizeof p);
-    int32_t i = new_node(cs, q, a, b, s);
-    int32_t t2 = new_tri(cs, t);
-    set_corner(m, t, ib, i, p);
-    set_corner(m, t2, ia, i, p);
-    normalize_shifts(m, t2);
-    mark_changed(cs, t);
-    if (u >= 0) {
-        int ua = fs_mesh_corner_of(m, u, a), ub = fs_mesh_corner_of(m, u, b);
-        double qa[3], qb[3], pu[3];
-        fs_mesh_corner(m, u, ua, qa);
-        fs_mesh_corner(m, u, ub, qb);
-        for (int k = 0; k < 3; k++)
-            pu[k] = qa[k] + s * (qb[k] - qa[k]);
-        if (!cs->w->flat)
-            memcpy(pu, q, sizeof pu);
-        int32_t u2 = new_tri(cs, u);
-        set_corner(m, u, ub, i, pu);
-        set_corner(m, u2, ua, i, pu);
-        normalize_shifts(m, u2);
-        mark_changed(cs, u);
-    }
-    return i;
 }
 
 /* Twice the signed area of triangle t projected into frame f. */
@@ -585,7 +452,7 @@ static bool collapse(cut_state *cs, const fs_wedge_frame *f, int32_t v, const do
         memcpy(m->pos + 3 * (size_t)v, old, sizeof old);
     else
         for (int32_t q = 0; q < ring.n; q++)
-            mark_changed(cs, ring.v[q]);
+            fs_cut_mark_changed(&cs->cut, ring.v[q]);
     free(before);
     free(ring.v);
     return ok;
@@ -610,7 +477,7 @@ static int32_t cast_ray(cut_state *cs, const fs_wedge_frame *f, int32_t n, const
         if (hit == FS_SPLIT_MISS)
             continue;
         if (hit == FS_SPLIT_EDGE) {
-            far = split_edge(cs, t, ia, s);
+            far = fs_cut_split_edge(&cs->cut, t, ia, s);
             break;
         }
         int c = hit == FS_SPLIT_AT_A ? ia : ib;
@@ -624,70 +491,6 @@ static int32_t cast_ray(cut_state *cs, const fs_wedge_frame *f, int32_t n, const
     }
     free(fan.v);
     return far;
-}
-
-static int32_t find_root(int32_t *parent, int32_t i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
-/* Splits node v into one copy per connected sector of its fan once the edges (v, cut[k]) are cut.
- * Returns the number of sectors (1: v stays whole). */
-static int32_t duplicate_node(cut_state *cs, int32_t v, const int32_t *cut, int32_t n_cut)
-{
-    fs_wedge_model *w = cs->w;
-    fs_mesh *m = w->mesh;
-    ilist fan = {0};
-    tris_at(cs, v, &fan);
-    int32_t *parent = fs_malloc(((size_t)fan.n + 1) * sizeof *parent);
-    for (int32_t q = 0; q < fan.n; q++)
-        parent[q] = q;
-    for (int32_t q = 0; q < fan.n; q++) {
-        int32_t t = fan.v[q];
-        int c = fs_mesh_corner_of(m, t, v);
-        for (int side = 0; side < 2; side++) {
-            int edge = side ? c : (c + 2) % 3; /* the two edges of t at v */
-            int32_t other = m->tri[3 * (size_t)t + (side ? (c + 1) % 3 : (c + 2) % 3)];
-            int32_t u = m->adj[3 * (size_t)t + edge];
-            if (u < 0)
-                continue;
-            bool is_cut = false;
-            for (int32_t k = 0; k < n_cut; k++)
-                is_cut |= cut[k] == other;
-            if (is_cut)
-                continue;
-            for (int32_t r = 0; r < fan.n; r++)
-                if (fan.v[r] == u) {
-                    int32_t x = find_root(parent, q), y = find_root(parent, r);
-                    if (x != y)
-                        parent[x > y ? x : y] = x < y ? x : y;
-                }
-        }
-    }
-    int32_t sectors = 0;
-    int32_t *copy = fs_malloc(((size_t)fan.n + 1) * sizeof *copy);
-    for (int32_t q = 0; q < fan.n; q++) {
-        int32_t r = find_root(parent, q);
-        if (r != q) {
-            copy[q] = copy[r];
-            continue;
-        }
-        copy[q] = sectors++ == 0 ? v : new_node(cs, m->pos + 3 * (size_t)v, v, v, 0.0);
-    }
-    for (int32_t q = 0; q < fan.n; q++)
-        if (copy[q] != v) {
-            int32_t t = fan.v[q];
-            m->tri[3 * (size_t)t + fs_mesh_corner_of(m, t, v)] = copy[q];
-            mark_changed(cs, t);
-        }
-    free(copy);
-    free(parent);
-    free(fan.v);
-    return sectors;
 }
 
 /* Elements within GRIFFITH_RINGS edge rings of node n (before a cut), ascending. */
@@ -767,7 +570,8 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
     fs_wedge_frame f;
     fs_wedge_frame_at(w, n, &f);
     const uint8_t *open = open_nodes(w);
-    cut_state cs = {w, m->n_nodes, m->n_tris, {0}, NULL, {0}, fs_calloc((size_t)m->n_tris + 1, 1), {0}, m->n_tris};
+    cut_state cs = {.w = w};
+    fs_cut_begin(&cs.cut, m, wedge_tris_at, w);
     int cuts = 0;
     for (int r = 0; r < n_rays; r++) {
         double d[2];
@@ -779,7 +583,7 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
             continue;
         d[0] /= len;
         d[1] /= len;
-        if (r > 0 && update_adjacency(&cs) < 0)
+        if (r > 0 && fs_cut_update_adjacency(&cs.cut) < 0)
             goto fail;
         int32_t far = cast_ray(&cs, &f, n, d, open);
         if (far < 0 || far == n)
@@ -793,10 +597,10 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
         cuts++;
     }
     if (cuts == 0) {
-        cut_free(&cs);
+        fs_cut_free(&cs.cut);
         return 0;
     }
-    if (update_adjacency(&cs) < 0)
+    if (fs_cut_update_adjacency(&cs.cut) < 0)
         goto fail;
     int32_t cut_ends[2], n_cut = 0;
     for (int r = 0; r < n_rays; r++)
@@ -806,28 +610,25 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
     int32_t sectors_far[2] = {1, 1};
     for (int r = 0; r < n_rays; r++)
         if (ends[r] >= 0) {
-            sectors_far[r] = duplicate_node(&cs, ends[r], &n, 1);
-            if (sectors_far[r] > 1 && update_adjacency(&cs) < 0)
+            sectors_far[r] = fs_cut_duplicate_node(&cs.cut, ends[r], &n, 1);
+            if (sectors_far[r] > 1 && fs_cut_update_adjacency(&cs.cut) < 0)
                 goto fail;
         }
-    duplicate_node(&cs, n, cut_ends, n_cut);
-    if (update_adjacency(&cs) < 0)
+    fs_cut_duplicate_node(&cs.cut, n, cut_ends, n_cut);
+    if (fs_cut_update_adjacency(&cs.cut) < 0)
         goto fail;
-    if (m->n_nodes == cs.n_nodes0 && m->n_tris == cs.n_tris0)
+    if (m->n_nodes == cs.cut.n_nodes_before && m->n_tris == cs.cut.n_tris_before)
         cuts = 0; /* the cut ran along an existing crack: nothing separated (geometry may have moved) */
     fs_mesh_drop_derived(m); /* the wedge model uses neither edges nor rings */
 
-    ilist changed = {0};
-    for (int32_t t = 0; t < cs.n_tris0; t++)
-        if (cs.changed[t])
-            ilist_push(&changed, t);
-    fs_wedge_change ch = {cs.n_nodes0, cs.n_tris0, cs.node_parent.v, cs.node_weight, cs.tri_parent.v,
-                          changed.v, changed.n};
+    int32_t *changed = fs_cut_changed_ascending(&cs.cut);
+    fs_wedge_change ch = {cs.cut.n_nodes_before, cs.cut.n_tris_before, cs.cut.node_parent, cs.cut.node_weight,
+                          cs.cut.tri_parent, changed, cs.cut.n_changed};
     bool end_open[2] = {false, false}; /* before the cut: the change makes the flags stale */
     for (int r = 0; r < n_rays; r++)
-        end_open[r] = ends[r] >= 0 && ends[r] < cs.n_nodes0 && open[ends[r]];
+        end_open[r] = ends[r] >= 0 && ends[r] < cs.cut.n_nodes_before && open[ends[r]];
     int rc = fs_wedge_apply_change(w, &ch);
-    free(changed.v);
+    free(changed);
     tip_remove(w, n);
     for (int r = 0; r < n_rays && cuts > 0; r++) {
         if (ends[r] < 0)
@@ -837,11 +638,11 @@ static int cut_at_node(fs_wedge_model *w, int32_t n, const double (*rays)[3], in
         if (sectors_far[r] == 1)
             tip_add(w, ends[r], rays[r]);
     }
-    cut_free(&cs);
+    fs_cut_free(&cs.cut);
     return rc < 0 ? -1 : cuts;
 fail:
     w->open_valid = false;
-    cut_free(&cs);
+    fs_cut_free(&cs.cut);
     return -1;
 }
 

@@ -3,9 +3,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/rng.h"
+#include "base/uf.h"
 #include "base/vec.h"
 #include "model/wedge/internal.h"
 #include "geom/sphere_surface.h"
@@ -14,21 +16,11 @@
  * before the chord is halved (geom/sphere_surface.h). */
 #define SPHERE_UV_TOLERANCE 5e-4
 
-static int32_t find_root(int32_t *parent, int32_t i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
 int32_t fs_wedge_fragments(const fs_wedge_model *w, int32_t *labels)
 {
     int32_t n = w->n_elems;
     int32_t *parent = fs_malloc((size_t)(n ? n : 1) * sizeof *parent);
-    for (int32_t e = 0; e < n; e++)
-        parent[e] = e;
+    fs_uf_init(parent, n);
     for (int32_t i = 0; i < w->n_nodes; i++) {
         int32_t first = -1;
         for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++) {
@@ -39,13 +31,7 @@ int32_t fs_wedge_fragments(const fs_wedge_model *w, int32_t *labels)
                 first = e;
                 continue;
             }
-            int32_t a = find_root(parent, first), b = find_root(parent, e);
-            if (a != b) {
-                if (a < b)
-                    parent[b] = a;
-                else
-                    parent[a] = b;
-            }
+            fs_uf_union(parent, first, e);
         }
     }
     /* roots are the smallest element of their component, so labels follow the smallest elements */
@@ -55,7 +41,7 @@ int32_t fs_wedge_fragments(const fs_wedge_model *w, int32_t *labels)
             labels[e] = -1;
             continue;
         }
-        int32_t r = find_root(parent, e);
+        int32_t r = fs_uf_find(parent, e);
         labels[e] = r == e ? count++ : labels[r];
     }
     free(parent);
@@ -178,7 +164,7 @@ static wall_point corner_point(const render_ctx *r, int32_t e, int c)
     for (int k = 0; k < 3; k++)
         p.top[k] = p.moved[k] + r->delta[3 * (size_t)p.id + k];
     if (r->parent)
-        p.vertex = find_root(r->parent, p.id);
+        p.vertex = fs_uf_find(r->parent, p.id);
     p.a = top_attr(r, e, p.id);
     return p;
 }
@@ -418,10 +404,7 @@ static int32_t points_on_edge(const render_ctx *r, const group_grid *g, const do
                 double off, t = edge_param(r, a->rest, b->rest, x.rest, &off);
                 if (!(t > 1e-9 && t < 1.0 - 1e-9) || !(off <= r->tol))
                     continue;
-                if (n == *cap) {
-                    *cap = *cap ? 2 * *cap : 8;
-                    *found = fs_realloc(*found, (size_t)*cap * sizeof **found);
-                }
+                FS_ARRAY_RESERVE(*found, *cap, n + 1, 8);
                 (*found)[n++] = (on_edge){t, grp};
             }
         }
@@ -601,10 +584,9 @@ static int32_t junction_loops(const render_ctx *r, const cross_edge *x, int32_t 
             bool closed = false;
             used[s] = 1;
             for (;;) {
-                if (n_pt + m == cap_pt) {
-                    cap_pt = cap_pt ? 2 * cap_pt : 16;
-                    pt = fs_realloc(pt, (size_t)cap_pt * sizeof *pt);
-                    ed = fs_realloc(ed, (size_t)cap_pt * sizeof *ed);
+                if (FS_ARRAY_GROW(cap_pt, n_pt + m + 1, 16)) {
+                    FS_ARRAY_RESIZE(pt, cap_pt);
+                    FS_ARRAY_RESIZE(ed, cap_pt);
                 }
                 pt[n_pt + m] = x[cur].from;
                 ed[n_pt + m] = cur;
@@ -663,10 +645,7 @@ static double loop_area2(const render_ctx *r, const wall_point *p, int32_t m)
 /* Joins the points a and b (vertices) of the surface. */
 static void join(render_ctx *r, int32_t a, int32_t b)
 {
-    a = find_root(r->parent, a);
-    b = find_root(r->parent, b);
-    if (a != b)
-        r->parent[a < b ? b : a] = a < b ? a : b;
+    fs_uf_union(r->parent, a, b);
 }
 
 /* Moves every joined set of points to its mean position: sets r->delta for each id, then redraws
@@ -681,7 +660,7 @@ static void apply_joins(render_ctx *r, wall_point *pts, int32_t n_pts, int32_t n
             rep[pts[k].id] = k;
     double *sum = fs_calloc(4 * (size_t)n_ids + 1, sizeof *sum); /* per root: 3 coordinates, count */
     for (int32_t i = 0; i < n_ids; i++) {
-        int32_t root = find_root(r->parent, i);
+        int32_t root = fs_uf_find(r->parent, i);
         if (rep[i] < 0 || root == i)
             continue;
         for (int32_t k = 0; k < 2; k++) { /* the root's own point once, then i's */
@@ -696,7 +675,7 @@ static void apply_joins(render_ctx *r, wall_point *pts, int32_t n_pts, int32_t n
         }
     }
     for (int32_t i = 0; i < n_ids; i++) {
-        int32_t root = find_root(r->parent, i);
+        int32_t root = fs_uf_find(r->parent, i);
         const double *s = sum + 4 * (size_t)root;
         if (rep[i] < 0 || s[3] < 2.0)
             continue;
@@ -709,7 +688,7 @@ static void apply_joins(render_ctx *r, wall_point *pts, int32_t n_pts, int32_t n
     for (int32_t k = 0; k < n_pts; k++) {
         for (int q = 0; q < 3; q++)
             pts[k].top[q] = pts[k].moved[q] + r->delta[3 * (size_t)pts[k].id + q];
-        pts[k].vertex = find_root(r->parent, pts[k].id);
+        pts[k].vertex = fs_uf_find(r->parent, pts[k].id);
     }
     free(sum);
     free(rep);
@@ -804,8 +783,7 @@ static int32_t close_crossings(render_ctx *r, wall_point *pts, int32_t n_pts, co
                                int32_t n_ids)
 {
     r->parent = fs_malloc(((size_t)n_ids + 1) * sizeof *r->parent);
-    for (int32_t i = 0; i < n_ids; i++)
-        r->parent[i] = i;
+    fs_uf_init(r->parent, n_ids);
     int32_t joined = 0;
     for (int32_t i = 0; i < n_pairs; i++) {
         wall_point quad[4]; /* q, p, q2, p2 */
@@ -820,7 +798,7 @@ static int32_t close_crossings(render_ctx *r, wall_point *pts, int32_t n_pts, co
             double gap[3];
             fs_sub3(gap, other->moved, mine->moved);
             if (mine->vertex != other->vertex && fs_dot3(gap, right) < 0.0
-                && find_root(r->parent, mine->id) != find_root(r->parent, other->id)) {
+                && fs_uf_find(r->parent, mine->id) != fs_uf_find(r->parent, other->id)) {
                 join(r, mine->id, other->id);
                 joined++;
             }
@@ -952,10 +930,7 @@ static int split_render_mesh(render_ctx *r)
                 continue;
             wall_point a = corner_point(r, e, c), b = corner_point(r, e, (c + 1) % 3);
             int32_t k = points_on_edge(r, &grid, gpos, &a, &b, &found, &cap_found);
-            if (n_pts + k + 2 > cap_pts) {
-                cap_pts = 2 * (n_pts + k + 2);
-                pts = fs_realloc(pts, (size_t)cap_pts * sizeof *pts);
-            }
+            FS_ARRAY_RESERVE(pts, cap_pts, n_pts + k + 2, 64);
             wall_first[wl] = n_pts;
             wall_n[wl] = k + 2;
             pts[n_pts++] = a;

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/sort.h"
@@ -402,12 +403,11 @@ static bool fan_of(const fs_wedge_model *w, int32_t i, const fs_wedge_frame *f, 
             if (u < 0 || w->state[u] != FS_WEDGE_ALIVE)
                 return false;
         }
-        if (fan->n == fan->cap) {
-            fan->cap = fan->cap ? 2 * fan->cap : 16;
-            fan->a = fs_realloc(fan->a, (size_t)fan->cap * sizeof *fan->a);
-            fan->b = fs_realloc(fan->b, (size_t)fan->cap * sizeof *fan->b);
-            fan->ra = fs_realloc(fan->ra, 2 * (size_t)fan->cap * sizeof *fan->ra);
-            fan->rb = fs_realloc(fan->rb, 2 * (size_t)fan->cap * sizeof *fan->rb);
+        if (FS_ARRAY_GROW(fan->cap, fan->n + 1, 16)) {
+            FS_ARRAY_RESIZE(fan->a, fan->cap);
+            FS_ARRAY_RESIZE(fan->b, fan->cap);
+            FS_ARRAY_RESIZE(fan->ra, 2 * (size_t)fan->cap);
+            FS_ARRAY_RESIZE(fan->rb, 2 * (size_t)fan->cap);
         }
         double pi[3], pa[3], pb[3], d[3];
         fs_mesh_corner(m, t, c, pi);

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/rng.h"
@@ -213,10 +214,7 @@ static void build_node_elems(fs_wedge_model *w)
 /* Entries of node_elem from node_elem_used on for a list of `room`; returns its start. */
 static int32_t node_elem_take(fs_wedge_model *w, int32_t room)
 {
-    if (w->node_elem_used + room > w->node_elem_capacity) {
-        w->node_elem_capacity = 2 * (w->node_elem_used + room);
-        w->node_elem = fs_realloc(w->node_elem, ((size_t)w->node_elem_capacity + 1) * sizeof *w->node_elem);
-    }
+    FS_ARRAY_RESERVE(w->node_elem, w->node_elem_capacity, w->node_elem_used + room, 64);
     int32_t start = w->node_elem_used;
     w->node_elem_used += room;
     return start;
@@ -1594,10 +1592,7 @@ static int cmp_int64(const void *a, const void *b)
 
 static void push_pair(int64_t **pairs, size_t *np, size_t *cap, int64_t key)
 {
-    if (*np == *cap) {
-        *cap = *cap ? 2 * *cap : 256;
-        *pairs = fs_realloc(*pairs, *cap * sizeof **pairs);
-    }
+    FS_ARRAY_RESERVE(*pairs, *cap, *np + 1, 256);
     (*pairs)[(*np)++] = key;
 }
 
@@ -1861,10 +1856,7 @@ static void mark_dirty(fs_wedge_model *w, const int32_t *nodes, int32_t nn)
 {
     if (!w->residual_valid)
         return;
-    if (w->n_dirty + nn > w->cap_dirty) {
-        w->cap_dirty = 2 * (w->n_dirty + nn);
-        w->dirty_nodes = fs_realloc(w->dirty_nodes, (size_t)w->cap_dirty * sizeof *w->dirty_nodes);
-    }
+    FS_ARRAY_RESERVE(w->dirty_nodes, w->cap_dirty, w->n_dirty + nn, 64);
     memcpy(w->dirty_nodes + w->n_dirty, nodes, (size_t)nn * sizeof *nodes);
     w->n_dirty += nn;
 }
