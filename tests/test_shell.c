@@ -130,11 +130,11 @@ static void test_energy_derivatives(void)
         double e = fs_shell_energy(s, x, g, true);
         CHECK(isfinite(e) && e > 0.0);
         /* the Hessian out of the upper CSC (no pins: DOF 3 i + k is free index 3 i + k) */
-        CHECK(s->n_free == (int32_t)n);
-        for (int32_t j = 0; j < s->K.n; j++)
-            for (int32_t q = s->K.col_ptr[j]; q < s->K.col_ptr[j + 1]; q++) {
-                int32_t i = s->K.row_idx[q];
-                h[(size_t)i * n + j] = h[(size_t)j * n + i] = s->K.values[q];
+        CHECK(s->sys.n_free == (int32_t)n);
+        for (int32_t j = 0; j < s->sys.K.n; j++)
+            for (int32_t q = s->sys.K.col_ptr[j]; q < s->sys.K.col_ptr[j + 1]; q++) {
+                int32_t i = s->sys.K.row_idx[q];
+                h[(size_t)i * n + j] = h[(size_t)j * n + i] = s->sys.K.values[q];
             }
         double step = 1e-6;
         for (size_t j = 0; j < n; j++) {

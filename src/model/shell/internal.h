@@ -57,9 +57,34 @@ typedef struct {
     int64_t steps;              /* accepted time steps */
     int64_t search_evaluations; /* equilibria of the event search */
     int64_t cuts;               /* fracture events: crack segments cut */
+    int64_t local_relaxations;  /* local Newton solves after cuts (shell/relax.c) */
+    int64_t local_nodes;        /* their nodes, summed */
+    int64_t global_fallbacks;   /* relaxations that needed the whole shell */
+    double relax_seconds;       /* time in fs_shell_relax, fallbacks included */
     int64_t budges;             /* vertices budged onto a crack line */
     double assemble_seconds, factor_seconds, solve_seconds, fracture_seconds;
 } fs_shell_counters;
+
+/* A Newton system over some of the shell's DOFs: the whole shell, or the nodes around a change for a
+ * local relaxation (shell/relax.c), whose energy is then summed over the triangles and bonds that
+ * depend on those nodes (the rest of the energy is constant while only they move). */
+typedef struct {
+    const int32_t *tris;           /* the triangles whose energy counts, or NULL for all */
+    int32_t n_tris;
+    const int32_t *nodes;          /* the nodes whose bond counts, or NULL for all */
+    int32_t n_nodes;
+    int32_t n_free;                /* unknowns */
+    int32_t *dof;                  /* 3 per mesh node: unknown of each component, or -1 (held) */
+    bool pattern_valid;            /* K's pattern, slots and analysis fit the mesh and dof */
+    fs_sparse_matrix K;            /* upper CSC of the Hessian over the unknowns */
+    int32_t *slots;                /* compression slots of the element blocks, in assembly order */
+    size_t n_slots;
+    fs_cholesky *chol;
+    bool factored;                 /* chol holds the factor of a recent Hessian of the current pattern */
+} fs_shell_system;
+
+/* Releases a system's arrays and factor and zeroes it. */
+void fs_shell_system_free(fs_shell_system *sys);
 
 struct fs_shell {
     fs_mesh *mesh;                 /* borrowed; fracture cuts it in place */
@@ -85,9 +110,15 @@ struct fs_shell {
     double *node_area;             /* per node: a third of the rest area of its triangles (cm^2) */
     uint8_t *pin;                  /* per node: bit k set when component k is held at x (tests) */
     double *f_ext;                 /* 3 per node: dead load (MPa cm^2), all 0 unless a test sets it */
+    double *tip_dir;               /* 3 per node: for a crack tip (the inner end of a crack), the unit
+                                      direction (rest, 3-D) the crack arrived in; zero for other nodes */
+    double *rate;                  /* 3 per node: d x / d t over the last accepted step (guesses) */
+    bool rate_valid;               /* rate fits the mesh and the last step */
     int32_t *origin;               /* per node: the node it was duplicated from by a crack (itself if
                                       none), so the two walls of a crack are the boundary edges with
                                       the same pair of origins */
+    double unit;                   /* mean rest edge length of the mesh as built (cm): the scale of the
+                                      shortest edge a crack may make */
     double bond_t, bond_n;         /* bond stiffness per unit area, tangential and normal (MPa / cm) at
                                       the base thickness and Young's modulus */
 
@@ -107,28 +138,22 @@ struct fs_shell {
                                       components of the domain's unit axes d_x, d_y at the triangle, so
                                       a domain tensor T is R T R^T in the frame */
 
-    /* Interior edges (hinges), indexed by mesh edge. */
-    int32_t n_edges, cap_edges;
-    int32_t *hinge;                /* 4 per edge: nodes a, b (the edge, a -> b counter-clockwise in the
-                                      first triangle), c1 (opposite in the first), c2 (in the second);
-                                      hinge[4e] = -1 for a boundary edge */
-    double *hinge_off;             /* 12 per edge: 3-D offsets (periods) added to the four nodes'
-                                      positions to unwrap the hinge in the first triangle's frame */
-    double *phi0;                  /* per edge: rest phi */
-    double *phi;                   /* per edge: phi at the positions of the last energy evaluation */
-    double *dphi;                  /* 12 per edge: its gradient there */
+    /* Hinges (interior edges), stored at the owner half-edge 3 t + i of each (energy.c). */
+    int32_t *twin;                 /* 3 per triangle: the half-edge across edge i (running the other
+                                      way), or -1 on a border or crack */
+    int32_t *hinge;                /* 4 per half-edge, at owners: nodes a, b (the edge, a -> b in the
+                                      owner's triangle), c1 (opposite in it), c2 (in the twin's) */
+    double *hinge_off;             /* 12 per half-edge, at owners: 3-D offsets (periods) added to the
+                                      four nodes' positions to unwrap the hinge in the owner's frame */
+    double *phi0;                  /* per half-edge, at owners: rest phi */
+    double *phi;                   /* per half-edge, at owners: phi at the positions of the last
+                                      evaluation */
+    double *dphi;                  /* 12 per half-edge, at owners: its gradient there */
 
-    /* The system: the free components of the nodes' positions. */
-    int32_t n_free;
-    int32_t *dof;                  /* 3 per node: free index, or -1 (pinned) */
-    bool pattern_valid;            /* K's pattern, slots and analysis fit the mesh */
-    fs_sparse_matrix K;            /* upper CSC of the Hessian over the free DOFs */
-    int32_t *slots;                /* compression slots of the element blocks, in assembly order */
-    size_t n_slots;
-    fs_cholesky *chol;
-    bool factored;                 /* chol holds the factor of a recent Hessian of the current pattern */
+    fs_shell_system sys;           /* the whole shell's system (no scope) */
     double *grad;                  /* 3 per node: gradient of the energy at x */
-    double *work;                  /* scratch: 2 n_free + 6 n_nodes */
+    double *work;                  /* scratch: 2 n_free + 6 n_nodes (reallocated to fit) */
+    size_t work_size;
 
     int64_t fractures;
     fs_shell_counters counters;
@@ -145,9 +170,18 @@ double fs_shell_hinge_phi(const double x[12], double *grad, double *hess);
 
 /* ---- energy.c ---- */
 
-/* Fills the rest data of the listed triangles (all when tris is NULL) from the rest positions and of
- * every edge (hinges, offsets, phi0); the mesh's edges must be built. Returns 0, or -1 with
- * fs_error(FS_ERR_DATA) for a degenerate triangle. */
+/* The owner of the hinge across half-edge h (3 t + i): the smaller of h and its twin; -1 on a
+ * border or crack. */
+int32_t fs_shell_owner(const fs_shell *s, int32_t h);
+
+/* Fills the rest data of the n listed triangles (all when tris is NULL) from the rest positions: the
+ * twins of their half-edges (from the mesh's adjacency, and of the half-edges that were across them:
+ * a new triangle's twins must be -1 on entry), frames, areas, bending terms, and the hinges of their
+ * edges with their rest phi. Returns 0, or -1 with fs_error(FS_ERR_DATA) for a degenerate triangle or
+ * a rest surface folded onto itself. */
+int fs_shell_rest_geometry_of(fs_shell *s, const int32_t *tris, int32_t n);
+
+/* fs_shell_rest_geometry_of every triangle. */
 int fs_shell_rest_geometry(fs_shell *s);
 
 /* The 3-D position of corner c of triangle t at the node positions p (3 per node): p plus the
@@ -162,6 +196,9 @@ void fs_shell_strains(const fs_shell *s, const double *p, int32_t t, double em[3
 /* Recomputes s->phi (and s->dphi when with_grad) of every hinge at positions p. */
 void fs_shell_update_phi(fs_shell *s, const double *p, bool with_grad);
 
+/* Recomputes s->phi of the hinges of the n listed triangles at positions p. */
+void fs_shell_update_phi_of(fs_shell *s, const double *p, const int32_t *tris, int32_t n);
+
 /* The eigenstrains of triangle t at the current time: membrane (xx, yy, xy) and curvature. */
 void fs_shell_eigenstrain(const fs_shell *s, int32_t t, double em[3], double ec[3]);
 
@@ -172,19 +209,32 @@ void fs_shell_elastic_strains(const fs_shell *s, const double *p, int32_t t, dou
 /* Local thickness (cm) of triangle t at the current time. */
 double fs_shell_tri_thickness(const fs_shell *s, int32_t t);
 
-/* Total energy at positions p (3 per node): membrane, bending, bond, minus the work of f_ext. With
- * grad (3 per node, may be NULL) its gradient; with hessian, the Hessian over the free DOFs into s->K
- * (the pattern is built first if not valid). Returns the energy, NaN for a degenerate state. */
+/* Total energy at positions p (3 per node): membrane, bending, bond, minus the work of f_ext, over
+ * sys's scope (the whole shell for &s->sys). With grad (3 per node, may be NULL) its gradient (exact
+ * for the nodes the scope was made for; the whole array is overwritten); with hessian, the Hessian
+ * over sys's unknowns into sys->K (the pattern is built first if not valid). Returns the energy, NaN
+ * for a degenerate state. */
+double fs_shell_energy_in(fs_shell *s, fs_shell_system *sys, const double *p, double *grad, bool hessian);
+
+/* fs_shell_energy_in over the whole shell. */
 double fs_shell_energy(fs_shell *s, const double *p, double *grad, bool hessian);
 
 /* ---- solve.c ---- */
 
-/* Numbers the free DOFs (pin) and invalidates the pattern. */
+/* Numbers the free DOFs of the whole shell (pin) and invalidates its pattern. */
 void fs_shell_number_dofs(fs_shell *s);
 
-/* Equilibrium at the current time and loads, by Newton's method with a backtracking line search from
- * s->x (updated in place). Returns 0, or -1 with fs_error(FS_ERR_INTERNAL) when it does not converge. */
+/* Equilibrium of sys's unknowns (the others held) at the current time and loads, by Newton's method
+ * with a backtracking line search from s->x (updated in place). Returns 0, or -1 with
+ * fs_error(FS_ERR_INTERNAL) when it does not converge. */
+int fs_shell_solve(fs_shell *s, fs_shell_system *sys);
+
+/* fs_shell_solve of the whole shell. */
 int fs_shell_equilibrium(fs_shell *s);
+
+/* The largest absolute gradient component over the whole shell's unknowns at s->x (the residual
+ * force, MPa cm^2). */
+double fs_shell_residual(fs_shell *s);
 
 /* ---- shell.c ---- */
 
@@ -197,6 +247,35 @@ void fs_shell_node_geometry(fs_shell *s);
 /* Builds the state on mesh like fs_shell_create, without solving; for white-box tests, which may then
  * pin nodes, set loads and call fs_shell_equilibrium. */
 fs_shell *fs_shell_build(fs_mesh *mesh, const fs_model_setup *setup);
+
+/* Grows the state's arrays to room for the given numbers of nodes and triangles (new entries zero). */
+void fs_shell_reserve(fs_shell *s, int32_t nodes, int32_t tris);
+
+/* ---- fracture.c ---- */
+
+/* The fracture ratio of face t at the current state (phi up to date, fs_shell_update_phi): the
+ * largest principal plane stress at z = +-h/2 over the face's threshold; m (may be NULL) receives
+ * the unit principal direction in the face's frame (the crack's normal). NaN on failure. */
+double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2]);
+
+/* The largest face ratio at the current state (updates phi); ratio (n_tris, may be NULL) gets each. */
+double fs_shell_max_ratio(fs_shell *s, double *ratio);
+
+/* ---- crack.c ---- */
+
+/* One batch of fracture events at the current time: the faces over their threshold, the highest
+ * ratio first (ties by the seed, fracture/rank.h), each cut unless a face near it was cut in this
+ * batch (its stresses are out of date until the next equilibrium). Does not re-solve. *seeds
+ * (caller frees) receives the *n_seeds nodes the cuts made or changed faces at. Returns the number of
+ * cracks opened, or -1 with fs_error. */
+int32_t fs_shell_fracture_batch(fs_shell *s, int32_t **seeds, int32_t *n_seeds);
+
+/* ---- relax.c ---- */
+
+/* Brings the shell back to equilibrium after cuts near the seeds (n_seeds nodes): a local relaxation
+ * of the nodes around them, grown until the residual anywhere is below solver.relax_tolerance of the
+ * residual it started from, else (or with solver.relax = global) the whole shell. Returns 0 or -1. */
+int fs_shell_relax(fs_shell *s, const int32_t *seeds, int32_t n_seeds);
 
 /* ---- plastic.c ---- */
 

@@ -79,7 +79,6 @@ void fs_shell_set_time(fs_shell *s, double t)
 
 /* ---- building ---- */
 
-/* Grows the node arrays to room for n nodes (new entries zero). */
 static void reserve_nodes(fs_shell *s, int32_t n)
 {
     if (n <= s->cap_nodes)
@@ -102,8 +101,10 @@ static void reserve_nodes(fs_shell *s, int32_t n)
     GROW(pin, 1);
     GROW(f_ext, 3);
     GROW(origin, 1);
+    GROW(tip_dir, 3);
+    GROW(rate, 3);
     GROW(grad, 3);
-    GROW(dof, 3);
+    GROW(sys.dof, 3);
     s->cap_nodes = cap;
 }
 
@@ -127,24 +128,21 @@ static void reserve_tris(fs_shell *s, int32_t n)
     GROW(plastic, 6);
     if (s->growth_mode == FS_SHELL_GROWTH_EIGENSTRAIN)
         GROW(axes, 4);
+    GROW(twin, 3);
+    GROW(hinge, 12);
+    GROW(hinge_off, 36);
+    GROW(phi0, 3);
+    GROW(phi, 3);
+    GROW(dphi, 36);
     s->cap_tris = cap;
 }
 
-static void reserve_edges(fs_shell *s, int32_t n)
-{
-    if (n <= s->cap_edges)
-        return;
-    int32_t cap = s->cap_edges ? s->cap_edges : 16;
-    while (cap < n)
-        cap *= 2;
-    size_t o = (size_t)s->cap_edges, c = (size_t)cap;
-    GROW(hinge, 4);
-    GROW(hinge_off, 12);
-    GROW(phi0, 1);
-    GROW(phi, 1);
-    GROW(dphi, 12);
-    s->cap_edges = cap;
 #undef GROW
+
+void fs_shell_reserve(fs_shell *s, int32_t nodes, int32_t tris)
+{
+    reserve_nodes(s, nodes);
+    reserve_tris(s, tris);
 }
 
 /* Texture coordinates of the corners of triangle t from the domain (plane and cylinder: the
@@ -283,14 +281,9 @@ fs_shell *fs_shell_build(fs_mesh *mesh, const fs_model_setup *setup)
     } else if (d->type == FS_DOMAIN_CYLINDER) {
         s->period[1][2] = d->height; /* around, the embedding closes by itself */
     }
-    if (!mesh->edge)
-        fs_mesh_build_edges(mesh);
     s->n_nodes = mesh->n_nodes;
     s->n_tris = mesh->n_tris;
-    s->n_edges = mesh->n_edges;
-    reserve_nodes(s, s->n_nodes);
-    reserve_tris(s, s->n_tris);
-    reserve_edges(s, s->n_edges);
+    fs_shell_reserve(s, s->n_nodes, s->n_tris);
     for (int32_t i = 0; i < s->n_nodes; i++) {
         const double *p = mesh->pos + 3 * (size_t)i;
         memcpy(s->anchor0 + 3 * (size_t)i, p, 3 * sizeof *p);
@@ -323,6 +316,16 @@ fs_shell *fs_shell_build(fs_mesh *mesh, const fs_model_setup *setup)
         return NULL;
     }
     fs_shell_node_geometry(s);
+    double total = 0.0;
+    for (int32_t t = 0; t < s->n_tris; t++)
+        for (int i = 0; i < 3; i++) {
+            double pa[3], pb[3], ab[3];
+            fs_shell_corner(s, s->rest, t, i, pa);
+            fs_shell_corner(s, s->rest, t, (i + 1) % 3, pb);
+            fs_sub3(ab, pb, pa);
+            total += fs_norm3(ab);
+        }
+    s->unit = s->n_tris ? total / (3.0 * s->n_tris) : 1.0;
     fs_shell_number_dofs(s);
     fs_shell_set_time(s, 0.0);
     return s;
@@ -336,32 +339,6 @@ fs_shell *fs_shell_create(fs_mesh *mesh, const fs_model_setup *setup)
         return NULL;
     }
     return s;
-}
-
-/* ---- the time loop ---- */
-
-int fs_shell_advance(fs_shell *s, double t_end)
-{
-    double step = s->cfg.shell.max_step * s->cfg.time.end;
-    while (s->time < t_end) {
-        double t = fmin(t_end, s->time + step);
-        if (t_end - t < 1e-9 * step)
-            t = t_end;
-        fs_shell_set_time(s, t);
-        if (fs_shell_equilibrium(s) < 0)
-            return -1;
-        s->counters.steps++;
-        if (s->cfg.shell.yield > 0.0) {
-            for (int round = 0; round < 20; round++) {
-                if (fs_shell_plastic_update(s) == 0)
-                    break;
-                if (fs_shell_equilibrium(s) < 0)
-                    return -1;
-            }
-        }
-        fs_progress("shell", t / t_end, "t = %.4g, %lld fractures", t, (long long)s->fractures);
-    }
-    return 0;
 }
 
 fs_model_info fs_shell_info(const fs_shell *s)
@@ -382,6 +359,9 @@ void fs_shell_report(const fs_shell *s)
     fs_debug("shell: assembly %.2f s, factorization %.2f s, solves %.2f s in all, fracture %.2f s; %lld plastic updates",
              c->assemble_seconds, c->factor_seconds, c->solve_seconds, c->fracture_seconds,
              (long long)c->plastic_updates);
+    fs_debug("shell: %lld local relaxations (%.0f nodes on average), %lld global fallbacks, %.2f s relaxing",
+             (long long)c->local_relaxations, c->local_relaxations ? (double)c->local_nodes / c->local_relaxations : 0.0,
+             (long long)c->global_fallbacks, c->relax_seconds);
 }
 
 void fs_shell_destroy(fs_shell *s)
@@ -397,8 +377,9 @@ void fs_shell_destroy(fs_shell *s)
     free(s->pin);
     free(s->f_ext);
     free(s->origin);
+    free(s->tip_dir);
+    free(s->rate);
     free(s->grad);
-    free(s->dof);
     free(s->uv);
     free(s->frame);
     free(s->dm_inv);
@@ -411,13 +392,12 @@ void fs_shell_destroy(fs_shell *s)
     free(s->plastic);
     free(s->axes);
     free(s->hinge);
+    free(s->twin);
     free(s->hinge_off);
     free(s->phi0);
     free(s->phi);
     free(s->dphi);
-    free(s->slots);
     free(s->work);
-    fs_sparse_matrix_free(&s->K);
-    fs_cholesky_free(s->chol);
+    fs_shell_system_free(&s->sys);
     free(s);
 }
