@@ -57,7 +57,7 @@ int main(int argc, char **argv)
         return 1;
     char obj[64];
     snprintf(obj, sizeof obj, "%s/mesh.obj", tmp);
-    if (fs_obj_write(obj, &l, "bench", NULL) < 0)
+    if (fs_obj_write(obj, &l, "bench", NULL, NULL) < 0)
         return fail();
     double t2 = fs_seconds();
     fs_image preview;

@@ -46,3 +46,15 @@ finish() {
     if [ "$failures" -eq 0 ]; then exit 0; fi
     printf '%d failure(s)\n' "$failures"; exit 1
 }
+# in_ci: whether this is a CI run (.ci/run sets CI=1; CI services set CI=true).
+in_ci() { case "${CI:-}" in "" | 0 | false | no) return 1 ;; *) return 0 ;; esac; }
+# missing WHAT: a client the test drives is not installed: the test fails in CI, where .ci/setup
+# installs it, and is skipped (exit 77) on a developer's machine without it.
+missing() {
+    if in_ci; then printf 'FAIL %s is missing (.ci/setup installs it)\n' "$1"; exit 1; fi
+    printf 'SKIP: %s is not installed (.ci/setup installs it)\n' "$1"; exit 77
+}
+# need COMMAND...: each COMMAND must be on PATH (see missing).
+need() {
+    for c in "$@"; do command -v "$c" >/dev/null 2>&1 || missing "$c"; done
+}

@@ -1,4 +1,4 @@
-/* Tests of the shared fracture kernels: eigen decomposition, principal stresses, ranking, event search. */
+/* Tests of the shared fracture kernels: eigen decomposition, principal stresses, nodal planes and the separation tensor, ranking, event search. */
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
@@ -9,6 +9,7 @@
 #include "fracture/eigen.h"
 #include "fracture/event.h"
 #include "fracture/rank.h"
+#include "fracture/separation.h"
 
 /* ---- eigen ---- */
 
@@ -591,6 +592,184 @@ static void test_event_errors(void)
     fs_error_clear();
 }
 
+/* ---- nodal planes and the separation tensor ---- */
+
+/* The nodal mean of two stresses, and its principal plane: sigma_xx 1 and 3 average to 2, normal x. */
+static void test_nodal_principal_plane(void)
+{
+    fs_nodal_stress mean = {{0.0}, 0};
+    double s[6];
+    CHECK(!fs_nodal_stress_mean(&mean, s) && s[0] == 0.0);
+    const double a[6] = {1, 0, 0, 0, 0, 0}, b[6] = {3, -1, 0, 0, 0, 0};
+    fs_nodal_stress_add(&mean, a);
+    fs_nodal_stress_add(&mean, b);
+    CHECK(fs_nodal_stress_mean(&mean, s) && mean.count == 2);
+    CHECK(s[0] == 2.0 && s[1] == -0.5 && s[2] == 0.0);
+    double sigma1, n[3];
+    CHECK(fs_nodal_principal_plane(s, &sigma1, n) == 0);
+    CHECK(sigma1 == 2.0 && n[0] == 1.0 && n[1] == 0.0 && n[2] == 0.0);
+    /* pure shear tau_xy = 1: sigma1 = 1 on the plane normal to (1, 1, 0) / sqrt 2 */
+    const double shear[6] = {0, 0, 0, 1, 0, 0};
+    CHECK(fs_nodal_principal_plane(shear, &sigma1, n) == 0);
+    CHECK_NEAR(sigma1, 1.0, 1e-15);
+    CHECK_NEAR(n[0], sqrt(0.5), 1e-15);
+    CHECK_NEAR(n[1], sqrt(0.5), 1e-15);
+    const double bad[6] = {NAN, 0, 0, 0, 0, 0};
+    fs_error_clear();
+    CHECK(fs_nodal_principal_plane(bad, &sigma1, NULL) == -1 && fs_error_domain() == FS_ERR_INTERNAL);
+    fs_error_clear();
+}
+
+/* Eq. 28: m(a) has eigenvalue |a| along a, 0 across it; m(0) = 0. */
+static void test_separation_m(void)
+{
+    double z[9] = {0};
+    const double a[3] = {3, 4, 0}, zero[3] = {0, 0, 0};
+    fs_separation_add_m(z, a, 1.0);
+    CHECK_NEAR(z[0] + z[4] + z[8], 5.0, 1e-15); /* trace |a| */
+    double za[3];
+    for (int i = 0; i < 3; i++)
+        za[i] = z[3 * i] * a[0] + z[3 * i + 1] * a[1] + z[3 * i + 2] * a[2];
+    CHECK_NEAR(za[0], 15.0, 1e-14); /* m(a) a = |a| a */
+    CHECK_NEAR(za[1], 20.0, 1e-14);
+    CHECK(z[2] == 0.0 && z[8] == 0.0);
+    double before[9];
+    memcpy(before, z, sizeof z);
+    fs_separation_add_m(z, zero, 1.0);
+    CHECK(same9(z, before));
+}
+
+/* Eqs. 29-30: a stress splits into its tensile and compressive parts, which add up to it. */
+static void test_separation_split_stress(void)
+{
+    const double tension[6] = {2, 0, 0, 0, 0, 0}, compression[6] = {-3, 0, 0, 0, 0, 0};
+    double p[6], q[6];
+    CHECK(fs_separation_split_stress(tension, p, q) == 0);
+    CHECK(p[0] == 2.0 && q[0] == 0.0);
+    CHECK(fs_separation_split_stress(compression, p, q) == 0);
+    CHECK(p[0] == 0.0 && q[0] == -3.0);
+    /* pure shear: eigenvalues +1 along (1, 1, 0) / sqrt 2 and -1 along (1, -1, 0) / sqrt 2 */
+    const double shear[6] = {0, 0, 0, 1, 0, 0};
+    CHECK(fs_separation_split_stress(shear, p, q) == 0);
+    CHECK_NEAR(p[0], 0.5, 1e-15);
+    CHECK_NEAR(p[1], 0.5, 1e-15);
+    CHECK_NEAR(p[3], 0.5, 1e-15);
+    CHECK_NEAR(q[0], -0.5, 1e-15);
+    CHECK_NEAR(q[1], -0.5, 1e-15);
+    CHECK_NEAR(q[3], 0.5, 1e-15);
+    /* random stresses: plus + minus = stress, plus has no negative and minus no positive eigenvalue */
+    double worst = 0.0;
+    for (uint64_t r = 0; r < 200; r++) {
+        double s[6], l[3];
+        for (int k = 0; k < 6; k++)
+            s[k] = fs_rand_range(31, FS_RNG_TEST, 6 * r + (uint64_t)k, -5.0, 5.0);
+        CHECK(fs_separation_split_stress(s, p, q) == 0);
+        for (int k = 0; k < 6; k++)
+            worst = fmax(worst, fabs(p[k] + q[k] - s[k]));
+        CHECK(fs_eigen_principal_stress(p, l, NULL) == 0 && l[2] > -1e-12);
+        CHECK(fs_eigen_principal_stress(q, l, NULL) == 0 && l[0] < 1e-12);
+    }
+    CHECK(worst < 1e-13);
+}
+
+/* The forces on a node shared by elements meeting it from the directions normal (outward normals
+ * of the elements at the node, unit cross-section): an element under stress s pulls the node with
+ * -s n. Tensile and compressive parts from the split of s. */
+static void node_forces(const double s[6], const double (*normal)[3], int n, double *f_plus, double *f_minus)
+{
+    double p[6], q[6];
+    CHECK(fs_separation_split_stress(s, p, q) == 0);
+    for (int e = 0; e < n; e++) {
+        const double *m = normal[e];
+        const double *parts[2] = {p, q};
+        double *out[2] = {f_plus + 3 * e, f_minus + 3 * e};
+        for (int h = 0; h < 2; h++) {
+            const double *v = parts[h];
+            out[h][0] = -(v[0] * m[0] + v[3] * m[1] + v[5] * m[2]);
+            out[h][1] = -(v[3] * m[0] + v[1] * m[1] + v[4] * m[2]);
+            out[h][2] = -(v[5] * m[0] + v[4] * m[1] + v[2] * m[2]);
+        }
+    }
+}
+
+/* Eq. 32 by hand: a node between two elements of a bar along x. Uniaxial tension pulls it apart
+ * along x (v+ = the stress, fracture plane normal to x); pure compression gives no positive
+ * eigenvalue; a cross of four elements in tension along x and compression along y separates along
+ * x only; one unbalanced force gives nothing. */
+static void test_separation_tensor_cases(void)
+{
+    const double bar[2][3] = {{1, 0, 0}, {-1, 0, 0}};
+    double fp[12], fm[12], z[9], v, n[3];
+    const double tension[6] = {2, 0, 0, 0, 0, 0};
+    node_forces(tension, bar, 2, fp, fm);
+    CHECK(fp[0] == -2.0 && fp[3] == 2.0 && fm[0] == 0.0 && fm[3] == 0.0);
+    fs_separation_tensor(fp, 2, fm, 2, z);
+    const double want[9] = {2, 0, 0, 0, 0, 0, 0, 0, 0};
+    CHECK(same9(z, want));
+    CHECK(fs_separation_largest(z, &v, n) == 0);
+    CHECK(v == 2.0 && n[0] == 1.0 && n[1] == 0.0 && n[2] == 0.0);
+
+    const double compression[6] = {-2, 0, 0, 0, 0, 0};
+    node_forces(compression, bar, 2, fp, fm);
+    fs_separation_tensor(fp, 2, fm, 2, z);
+    CHECK(z[0] == -2.0);
+    CHECK(fs_separation_largest(z, &v, n) == 0);
+    CHECK_MSG(!(v > 0.0), "compression has a tensile eigenvalue %g", v);
+
+    const double cross[4][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
+    const double mixed[6] = {3, -1, 0, 0, 0, 0};
+    node_forces(mixed, cross, 4, fp, fm);
+    fs_separation_tensor(fp, 4, fm, 4, z);
+    const double want_mixed[9] = {3, 0, 0, 0, -1, 0, 0, 0, 0};
+    CHECK(same9(z, want_mixed));
+    CHECK(fs_separation_largest(z, &v, n) == 0 && v == 3.0 && n[0] == 1.0);
+
+    const double alone[3] = {0.3, -2.0, 1.0};
+    fs_separation_tensor(alone, 1, NULL, 0, z);
+    for (int k = 0; k < 9; k++)
+        CHECK_NEAR(z[k], 0.0, 1e-15);
+    fs_separation_tensor(NULL, 0, alone, 1, z);
+    for (int k = 0; k < 9; k++)
+        CHECK_NEAR(z[k], 0.0, 1e-15);
+}
+
+/* zeta is symmetric, and turning every force by a rotation Q turns zeta into Q zeta Q^T (the same
+ * eigenvalues): the tensor does not depend on the frame. */
+static void test_separation_tensor_symmetry(void)
+{
+    for (uint64_t trial = 0; trial < 50; trial++) {
+        double fp[15], fm[9], rp[15], rm[9], q[9], z[9], zr[9];
+        for (int k = 0; k < 15; k++)
+            fp[k] = fs_rand_range(41, FS_RNG_TEST, 24 * trial + (uint64_t)k, -1.0, 1.0);
+        for (int k = 0; k < 9; k++)
+            fm[k] = fs_rand_range(41, FS_RNG_TEST, 24 * trial + 15 + (uint64_t)k, -1.0, 1.0);
+        random_rotation(100 + trial, q);
+        for (int f = 0; f < 8; f++) {
+            const double *src = f < 5 ? fp + 3 * f : fm + 3 * (f - 5);
+            double *dst = f < 5 ? rp + 3 * f : rm + 3 * (f - 5);
+            for (int i = 0; i < 3; i++)
+                dst[i] = q[3 * i] * src[0] + q[3 * i + 1] * src[1] + q[3 * i + 2] * src[2];
+        }
+        fs_separation_tensor(fp, 5, fm, 3, z);
+        fs_separation_tensor(rp, 5, rm, 3, zr);
+        double worst = 0.0, asym = 0.0;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                double qzq = 0.0;
+                for (int k = 0; k < 3; k++)
+                    for (int l = 0; l < 3; l++)
+                        qzq += q[3 * i + k] * z[3 * k + l] * q[3 * j + l];
+                worst = fmax(worst, fabs(qzq - zr[3 * i + j]));
+                asym = fmax(asym, fabs(z[3 * i + j] - z[3 * j + i]));
+            }
+        CHECK(asym == 0.0);
+        CHECK_MSG(worst < 1e-13, "rotated tensor off by %g", worst);
+        double v1, v2;
+        CHECK(fs_separation_largest(z, &v1, NULL) == 0 && fs_separation_largest(zr, &v2, NULL) == 0);
+        CHECK_NEAR(v1, v2, 1e-13);
+    }
+}
+
 int main(void)
 {
     RUN(test_eigen_random);
@@ -598,6 +777,11 @@ int main(void)
     RUN(test_eigen_exact_cases);
     RUN(test_principal_stress);
     RUN(test_principal_bound);
+    RUN(test_nodal_principal_plane);
+    RUN(test_separation_m);
+    RUN(test_separation_split_stress);
+    RUN(test_separation_tensor_cases);
+    RUN(test_separation_tensor_symmetry);
     RUN(test_rank_largest);
     RUN(test_rank_ties);
     RUN(test_event_quadratic);

@@ -287,7 +287,7 @@ static void obj_file(void)
     char path[2][64];
     for (int k = 0; k < 2; k++) {
         snprintf(path[k], sizeof path[k], "%s/m%d.obj", dir, k);
-        CHECK(fs_obj_write(path[k], &l, "step", "test") == 0);
+        CHECK(fs_obj_write(path[k], &l, "step", "test", NULL) == 0);
     }
     FILE *f = fopen(path[0], "r");
     CHECK(f != NULL);
@@ -306,7 +306,7 @@ static void obj_file(void)
     char cmd[200];
     snprintf(cmd, sizeof cmd, "cmp -s %s %s", path[0], path[1]);
     CHECK(system(cmd) == 0);
-    CHECK(fs_obj_write("/nonexistent-dir/m.obj", &l, "step", NULL) < 0 && fs_error_domain() == FS_ERR_IO);
+    CHECK(fs_obj_write("/nonexistent-dir/m.obj", &l, "step", NULL, NULL) < 0 && fs_error_domain() == FS_ERR_IO);
     for (int k = 0; k < 2; k++)
         unlink(path[k]);
     rmdir(dir);

@@ -66,10 +66,44 @@ static void test_silent_off_terminal(void)
     CHECK_MSG(!strcmp(text, "fissure: a log line\n"), "stderr got '%s'", text);
 }
 
+/* JSON progress lines: the fields in order, null for an unknown fraction, fractions clamped,
+ * quotes, backslashes and control characters escaped, and a message too long for the buffer cut
+ * so that the line stays one valid object. */
+static void test_json_line(void)
+{
+    char buf[512];
+    fs_progress_json(buf, sizeof buf, "wedge", 0.25, "t = 0.25, 3 fractures", 1.5);
+    CHECK_MSG(!strcmp(buf, "{\"phase\": \"wedge\", \"fraction\": 0.2500, \"message\": \"t = 0.25, 3 fractures\", "
+                           "\"elapsed\": 1.500}"),
+              "got %s", buf);
+    fs_progress_json(buf, sizeof buf, "render", -1.0, "say \"hi\"\\\n\t", 0.0);
+    CHECK_MSG(!strcmp(buf, "{\"phase\": \"render\", \"fraction\": null, \"message\": \"say \\\"hi\\\"\\\\\\n\\u0009\", "
+                           "\"elapsed\": 0.000}"),
+              "got %s", buf);
+    fs_progress_json(buf, sizeof buf, "done", 1.7, "", 2.0);
+    CHECK(strstr(buf, "\"fraction\": 1.0000") != NULL);
+    char longer[2000];
+    memset(longer, '"', sizeof longer - 1);
+    longer[sizeof longer - 1] = '\0';
+    fs_progress_json(buf, 200, "p", 0.5, longer, 3.0);
+    size_t n = strlen(buf);
+    CHECK(n < 200);
+    CHECK_MSG(n > 20 && !strcmp(buf + n - 20, "\", \"elapsed\": 3.000}"), "got %s", buf);
+    /* the message is cut between escapes, never inside one */
+    const char *m = strstr(buf, "\"message\": \"") + 12;
+    size_t quotes = 0;
+    for (const char *p = m; *p && p < buf + n - 20; p += 2) {
+        CHECK(p[0] == '\\' && p[1] == '"');
+        quotes++;
+    }
+    CHECK(quotes > 10);
+}
+
 int main(void)
 {
     RUN(test_format_fields);
     RUN(test_eta);
     RUN(test_silent_off_terminal);
+    RUN(test_json_line);
     return check_finish();
 }

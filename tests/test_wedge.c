@@ -531,7 +531,7 @@ static double fresh_ratio(const fs_wedge_model *w, int32_t e)
     return best / w->threshold[e];
 }
 
-/* Lazy ratios (element_ratios in wedge.c) skip elements whose bound cannot have reached 1 since their
+/* Lazy ratios (fs_wedge_element_ratios in wedge/equilibrium.c) skip elements whose bound cannot have reached 1 since their
  * last evaluation: along a run of removals at one time, every ratio still bounds the exact one from
  * the displacements, the model removes the same elements in the same order as with every ratio
  * evaluated, and some elements were indeed skipped (their stored stress is older than the state). */

@@ -277,7 +277,7 @@ static void test_radius_control(void)
     CHECK(w.counters.global_fallbacks == 1);
     CHECK(w.counters.relax_retries >= 1);
     CHECK_NEAR(w.relax_radius, w.relax_unit * pow(2.0, (double)w.counters.relax_retries + 1.0), 1e-9);
-    CHECK(w.factor_stale); /* the fallback solved by CG (see solve() in wedge.c) */
+    CHECK(w.factor_stale); /* the fallback solved by CG (see solve() in wedge/equilibrium.c) */
     CHECK(fs_wedge_equilibrium(&g, 1.0) == 0);
     CHECK_MSG(u_diff(&w, &g) < 1e-6, "the fallback and the factor differ by %.3g of the largest", u_diff(&w, &g));
 

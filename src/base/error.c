@@ -1,6 +1,7 @@
 /* Error reporting and checked allocation. */
 #include "base/error.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <string.h>
 
@@ -23,6 +24,25 @@ void fs_error_clear(void)
 {
     error_message[0] = '\0';
     error_domain = FS_OK;
+}
+
+void fs_invariant_failed(const char *file, int line, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "fissure: internal error: %s:%d: invariant broken: ", file, line);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    abort();
+}
+
+int64_t fs_first_nonfinite(const double *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(v[i]))
+            return (int64_t)i;
+    return -1;
 }
 
 static void *check_alloc(void *p, size_t size)

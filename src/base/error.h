@@ -2,6 +2,7 @@
 #ifndef FS_BASE_ERROR_H
 #define FS_BASE_ERROR_H
 
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -34,6 +35,26 @@ void fs_error_clear(void);
             abort();                                                                       \
         }                                                                                  \
     } while (0)
+
+/* design: a --enable-validate build (./configure defines FS_VALIDATE in config.h) also checks, after
+ * every change of a model's mesh, system or state, the invariants the rest of the code relies on:
+ * a manifold, consistently oriented mesh with valid adjacency, a symmetric stiffness stored as a
+ * consistent upper triangle, finite displacements and stresses. The checks cost a pass over the model
+ * each, so they are compiled only there, in #ifdef FS_VALIDATE blocks of the models; a broken invariant
+ * is a programming error and aborts through FS_INVARIANT with a message naming it. */
+
+/* Aborts with file, line and the printf-style message unless cond holds. */
+#define FS_INVARIANT(cond, ...)                                      \
+    do {                                                             \
+        if (!(cond))                                                 \
+            fs_invariant_failed(__FILE__, __LINE__, __VA_ARGS__);    \
+    } while (0)
+
+void fs_invariant_failed(const char *file, int line, const char *fmt, ...)
+    __attribute__((noreturn, format(printf, 3, 4)));
+
+/* The index of the first entry of v[0 .. n) that is NaN or infinite, or -1 if all are finite. */
+int64_t fs_first_nonfinite(const double *v, size_t n);
 
 /* Allocation that aborts on exhaustion: out-of-memory is not a recoverable input error here. */
 void *fs_malloc(size_t size);

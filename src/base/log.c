@@ -110,8 +110,102 @@ static int terminal_columns(void)
     return 80;
 }
 
+static fs_progress_mode progress_mode = FS_PROGRESS_AUTO;
+
+/* The JSON lines' state: when they count from, and the last one written. */
+static struct {
+    double origin;
+    double last;
+    char phase[32];
+} json_prog;
+
+void fs_progress_set_mode(fs_progress_mode mode)
+{
+    progress_mode = mode;
+    json_prog.origin = fs_seconds();
+    json_prog.last = -1.0;
+    json_prog.phase[0] = '\0';
+}
+
+/* Appends s as a JSON string body (escaped) to buf at *n, stopping before a character that would
+ * not fit with room for `reserve` more bytes. */
+static void json_escape(char *buf, size_t size, size_t *n, const char *s, size_t reserve)
+{
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        char esc[8];
+        if (*p == '"' || *p == '\\')
+            snprintf(esc, sizeof esc, "\\%c", *p);
+        else if (*p == '\n')
+            snprintf(esc, sizeof esc, "\\n");
+        else if (*p < 0x20)
+            snprintf(esc, sizeof esc, "\\u%04x", *p);
+        else
+            snprintf(esc, sizeof esc, "%c", *p);
+        size_t len = strlen(esc);
+        if (*n + len + reserve >= size)
+            return;
+        memcpy(buf + *n, esc, len);
+        *n += len;
+    }
+}
+
+char *fs_progress_json(char *buf, size_t size, const char *phase, double fraction, const char *message,
+                       double elapsed)
+{
+    char tail[96], frac[16];
+    if (fraction >= 0.0)
+        snprintf(frac, sizeof frac, "%.4f", fraction > 1.0 ? 1.0 : fraction);
+    else
+        snprintf(frac, sizeof frac, "null");
+    snprintf(tail, sizeof tail, "\", \"elapsed\": %.3f}", elapsed > 0.0 ? elapsed : 0.0);
+    size_t n = 0;
+    buf[0] = '\0';
+    if (size < 128)
+        return buf;
+    n += (size_t)snprintf(buf, size, "{\"phase\": \"");
+    json_escape(buf, size, &n, phase, 64 + strlen(tail));
+    n += (size_t)snprintf(buf + n, size - n, "\", \"fraction\": %s, \"message\": \"", frac);
+    json_escape(buf, size, &n, message, strlen(tail) + 1);
+    snprintf(buf + n, size - n, "%s", tail);
+    return buf;
+}
+
+static void json_line(const char *phase, double fraction, const char *message)
+{
+    char line[640];
+    fs_progress_json(line, sizeof line, phase, fraction, message, fs_seconds() - json_prog.origin);
+    fprintf(stderr, "%s\n", line);
+    fflush(stderr);
+}
+
+void fs_progress_end(int ok, const char *message)
+{
+    fs_progress_done();
+    if (progress_mode == FS_PROGRESS_JSON)
+        json_line(ok ? "done" : "failed", ok ? 1.0 : -1.0, message ? message : "");
+}
+
 void fs_progress(const char *phase, double fraction, const char *fmt, ...)
 {
+    if (progress_mode == FS_PROGRESS_NONE)
+        return;
+    if (progress_mode == FS_PROGRESS_JSON) {
+        double now = fs_seconds();
+        if (fraction >= 0.0)
+            fraction *= prog.scale > 0.0 ? prog.scale : 1.0;
+        bool same = !strncmp(json_prog.phase, phase, sizeof json_prog.phase - 1);
+        if (same && now - json_prog.last < 0.25 && !(fraction >= 1.0))
+            return;
+        char detail[400];
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(detail, sizeof detail, fmt, ap);
+        va_end(ap);
+        json_line(phase, fraction, detail);
+        json_prog.last = now;
+        snprintf(json_prog.phase, sizeof json_prog.phase, "%s", phase);
+        return;
+    }
     if (log_level < FS_LOG_NORMAL)
         return;
     if (prog.tty < 0)

@@ -41,6 +41,32 @@ char *fs_progress_format(char *buf, size_t size, const char *phase, double fract
  * when it has not advanced by at least 0.5 % or the inputs are out of range. */
 double fs_progress_eta(double seconds, double f0, double f);
 
+/* How progress is reported (--progress). */
+typedef enum {
+    FS_PROGRESS_AUTO = 0, /* the line above, when stderr is a terminal and not quiet */
+    FS_PROGRESS_JSON,     /* machine-readable lines on stderr, whatever stderr is, even when quiet */
+    FS_PROGRESS_NONE      /* nothing */
+} fs_progress_mode;
+
+/* Sets the mode (AUTO at start); elapsed times count from this call. In JSON mode every
+ * fs_progress call writes one line holding one JSON object (fs_progress_json), except that within
+ * one phase lines come at most 4 times a second (a change of phase, or a fraction reaching 1, is
+ * always written). */
+void fs_progress_set_mode(fs_progress_mode mode);
+
+/* Ends the progress of a run: clears the terminal line, and in JSON mode writes the last line:
+ * phase "done" with fraction 1 when ok, else phase "failed" with fraction null; message is its
+ * detail (the error for a failure). */
+void fs_progress_end(int ok, const char *message);
+
+/* One JSON progress line, without the newline, into buf (size bytes; a message that does not fit
+ * is cut, keeping the line valid JSON):
+ *   {"phase": "PHASE", "fraction": F, "message": "DETAIL", "elapsed": S}
+ * F in [0, 1] with 4 decimals, or null when negative (unknown); S in seconds with 3 decimals.
+ * Returns buf. */
+char *fs_progress_json(char *buf, size_t size, const char *phase, double fraction, const char *message,
+                       double elapsed);
+
 /* Wall-clock seconds since an arbitrary origin (monotonic). */
 double fs_seconds(void);
 

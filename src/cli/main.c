@@ -6,13 +6,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "base/error.h"
 #include "base/log.h"
 #include "base/threads.h"
 #include "cli/cli.h"
+#include "cli/jobs.h"
 #include "config.h"
-#include "io/obj.h"
+#include "io/asset.h"
 #include "io/output.h"
 #include "io/preset.h"
 #include "io/sidecar.h"
@@ -45,13 +47,18 @@ typedef struct {
     fs_normal_convention normal;
     bool list_presets, dump_preset;
     fs_target target;      /* --target: the engine the maps are named, packed and oriented for */
+    bool have_target;      /* --target was given (--asset accepts only gltf) */
     const char *mesh_path; /* --mesh FILE: the lifted 3-D layer as Wavefront OBJ, or NULL */
+    const char *asset_path; /* --asset FILE: the layer and its material as glTF (.gltf or .glb), or NULL */
     bool have_maps;        /* --maps was given (it also picks the frames' maps) */
     int32_t frames;        /* --frames N: time-lapse frames, 0 for none */
+    const char *job;       /* --job FILE:N: run job N of a jobs file (cli/jobs.h), or NULL */
+    const char *list_jobs; /* --list-jobs FILE */
 } options;
 
 enum {
-    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET, OPT_FRAMES
+    OPT_SIZE = 256, OPT_SET, OPT_MAPS, OPT_FORMAT, OPT_NORMAL, OPT_LIST, OPT_DUMP, OPT_MESH, OPT_TARGET, OPT_FRAMES,
+    OPT_ASSET, OPT_JOB, OPT_LIST_JOBS, OPT_PROGRESS
 };
 
 /* Most time-lapse frames one run writes. */
@@ -72,6 +79,10 @@ static const struct option long_options[] = {
     {"list-presets", no_argument, NULL, OPT_LIST},
     {"dump-preset", no_argument, NULL, OPT_DUMP},
     {"mesh", required_argument, NULL, OPT_MESH},
+    {"asset", required_argument, NULL, OPT_ASSET},
+    {"job", required_argument, NULL, OPT_JOB},
+    {"list-jobs", required_argument, NULL, OPT_LIST_JOBS},
+    {"progress", required_argument, NULL, OPT_PROGRESS},
     {"frames", required_argument, NULL, OPT_FRAMES},
     {"threads", required_argument, NULL, 'j'},
     {"help", no_argument, NULL, 'h'},
@@ -82,6 +93,7 @@ static const struct option long_options[] = {
 static void print_help(FILE *out)
 {
     fputs("Usage: fissure [OPTION]... PRESET\n"
+          "       fissure [OPTION]... --job FILE:N\n"
           "       fissure diff [OPTION]... A B\n"
           "Grow a crack pattern by simulation and render it into texture maps.\n"
           "PRESET is a preset file, or the name of one found on the preset path.\n"
@@ -100,12 +112,23 @@ static void print_help(FILE *out)
           "                          normal map convention (default: opengl, +Y up)\n"
           "      --target ENGINE     name, pack and orient the maps for generic (default), gltf,\n"
           "                          unreal, unity-hdrp or blender\n"
-          "      --mesh FILE         also write the cracked 3-D layer to FILE as Wavefront OBJ\n"
+          "      --mesh FILE         also write the cracked 3-D layer to FILE as Wavefront OBJ, with its\n"
+          "                          material (the maps bound) in FILE.mtl; {name} in FILE stands for\n"
+          "                          the output name (as in --asset)\n"
+          "      --asset FILE        also write the layer and a PBR material binding the maps as a glTF\n"
+          "                          2.0 asset: FILE.gltf (with FILE.bin) or FILE.glb (images embedded);\n"
+          "                          implies --target gltf\n"
           "      --frames N          also write N time-lapse frames NAME_frame_0001_MAP.png ... of the\n"
           "                          crack growth (maps: those of --maps that are texture maps, else\n"
           "                          basecolor and crackmask; springs and wedge models only)\n"
           "  -j, --threads N         run parallel work on at most N threads, 1 to 256, or 0 for one\n"
           "                          per processor (default); the results do not depend on N\n"
+          "      --job FILE:N        run job N (from 1) of the jobs file FILE, one job a line:\n"
+          "                          PRESET SEED NAME [SECTION.KEY=VALUE]... (see fissure(1))\n"
+          "      --list-jobs FILE    list the jobs of FILE, one a line, and exit\n"
+          "      --progress auto|json|none\n"
+          "                          progress on stderr: a line redrawn on a terminal (auto, the\n"
+          "                          default), one JSON object a line (json), or none\n"
           "  -q, --quiet             print nothing on stderr but errors\n"
           "  -v, --verbose           print details of each phase on stderr\n"
           "      --list-presets      list the presets on the preset path, one a line, and exit\n"
@@ -219,7 +242,27 @@ static int parse_options(int argc, char **argv, options *o)
             if (fs_target_parse(optarg, &o->target) < 0)
                 return usage_error("--target: expected generic, gltf, unreal, unity-hdrp or blender, got '%s'",
                                    optarg);
+            o->have_target = true;
             break;
+        case OPT_JOB: o->job = optarg; break;
+        case OPT_LIST_JOBS: o->list_jobs = optarg; break;
+        case OPT_PROGRESS:
+            if (strcmp(optarg, "auto") && strcmp(optarg, "json") && strcmp(optarg, "none"))
+                return usage_error("--progress: expected auto, json or none, got '%s'", optarg);
+            fs_progress_set_mode(!strcmp(optarg, "json")   ? FS_PROGRESS_JSON
+                                 : !strcmp(optarg, "none") ? FS_PROGRESS_NONE
+                                                           : FS_PROGRESS_AUTO);
+            break;
+        case OPT_ASSET: {
+            size_t n = strlen(optarg);
+            size_t stem = n > 5 && !strcasecmp(optarg + n - 5, ".gltf") ? n - 5
+                          : n > 4 && !strcasecmp(optarg + n - 4, ".glb") ? n - 4
+                                                                         : 0;
+            if (stem == 0 || optarg[stem - 1] == '/')
+                return usage_error("--asset: expected a file name ending in .gltf or .glb, got '%s'", optarg);
+            o->asset_path = optarg;
+            break;
+        }
         case OPT_FRAMES: {
             char *end;
             errno = 0;
@@ -255,6 +298,11 @@ static int parse_options(int argc, char **argv, options *o)
         default: fputs("Try 'fissure --help' for more information.\n", stderr); return FS_ERR_USAGE;
         }
     }
+    if (o->asset_path && o->have_target && o->target != FS_TARGET_GLTF)
+        return usage_error("--asset binds the maps as --target gltf writes them; it cannot be used with --target %s",
+                           fs_target_name(o->target));
+    if (o->asset_path)
+        o->target = FS_TARGET_GLTF;
     if (o->have_normal && fs_target_fixes_normal(o->target) && o->normal != fs_target_normal(o->target)) {
         char what[160];
         snprintf(what, sizeof what, "--normal %s conflicts with --target %s, whose normal maps are %s",
@@ -267,7 +315,7 @@ static int parse_options(int argc, char **argv, options *o)
 
 static int fail(void)
 {
-    fs_progress_done();
+    fs_progress_end(0, fs_error_message());
     fprintf(stderr, "fissure: %s\n", fs_error_message());
     int status = fs_error_domain();
     return status == FS_OK ? FS_ERR_INTERNAL : status;
@@ -313,38 +361,6 @@ static int load_config(const char *arg, const options *o, fs_config *cfg, char *
     if (fs_target_fixes_normal(o->target))
         cfg->render.normal = fs_target_normal(o->target);
     return fs_preset_validate(cfg, *preset_path);
-}
-
-/* Lifts the result into 3-D and stages it as OBJ in the directory of path, which may lie outside
- * the output directory. Returns the staged output set, or NULL with fs_error. */
-static fs_output *stage_mesh(const char *path, const fs_config *cfg, const fs_result *res, const char *name)
-{
-    char *dir = fs_strdup(path);
-    char *slash = strrchr(dir, '/');
-    const char *file = slash ? path + (slash - dir) + 1 : path;
-    if (!slash)
-        strcpy(dir, ".");
-    else
-        slash[slash == dir ? 1 : 0] = '\0';
-    fs_output *out = fs_output_begin(dir);
-    free(dir);
-    if (!out)
-        return NULL;
-    fs_lifted_mesh lifted;
-    int rc = fs_render_lift(&res->surface, &res->mesh.domain, 1.0, &lifted);
-    if (rc == 0) {
-        char comment[200];
-        snprintf(comment, sizeof comment, "fissure %s: preset %s, seed %" PRIu64 ", %s model on a %s", PACKAGE_VERSION,
-                 cfg->preset.name, cfg->preset.seed, fs_model_name(cfg->preset.model),
-                 fs_domain_type_name(cfg->domain.type));
-        rc = fs_obj_write(fs_output_stage(out, file), &lifted, name, comment);
-    }
-    fs_lifted_mesh_free(&lifted);
-    if (rc < 0) {
-        fs_output_abort(out);
-        return NULL;
-    }
-    return out;
 }
 
 /* Map kinds a time-lapse frame can have: the texture-space rasters. */
@@ -503,9 +519,18 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
         rc = fs_target_write(out, o->target, name, kinds, n_kinds, &in, written);
     fs_image_free(&occlusion);
     fs_crackgraph_free(&cracks);
-    fs_output *mesh_out = NULL;
-    if (rc == 0 && o->mesh_path && !(mesh_out = stage_mesh(o->mesh_path, cfg, res, name)))
-        rc = -1;
+    fs_output *mesh_out = NULL, *asset_out = NULL;
+    fs_config lift_cfg = *cfg; /* the lift needs the domain as read (a mesh domain's texture size) */
+    lift_cfg.domain = res->mesh.domain;
+    fs_asset_inputs asset = {o->mesh_path, o->asset_path, &res->surface, &lift_cfg, name, o->output_dir, out,
+                             written->map, written->n, fs_target_name(o->target), maps->height_min_cm,
+                             maps->height_max_cm};
+    if (rc == 0)
+        rc = fs_asset_stage(&asset, &mesh_out, &asset_out);
+    const int n = written->n;
+    char asset_files[4][1024], asset_paths[4][1024];
+    int n_asset = rc == 0 ? fs_asset_files(&asset, written->map + n, asset_files, asset_paths) : 0;
+    written->n += n_asset;
     char json_name[600];
     snprintf(json_name, sizeof json_name, "%s.json", name);
     char frame_pattern[600];
@@ -517,23 +542,27 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
                               fs_target_name(o->target), written->map, written->n, o->frames ? &frames : NULL,
                               fs_seconds() - t_start);
     fs_target_output_free(written);
-    const int n = written->n;
     if (rc < 0) {
         free(written);
         fs_image_free(&exr_height);
         fs_output_abort(out);
-        if (mesh_out)
-            fs_output_abort(mesh_out);
+        fs_output_abort(mesh_out);
+        fs_output_abort(asset_out);
         return -1;
     }
     fs_image_free(&exr_height);
     if (fs_output_commit(out) < 0) {
         free(written);
-        if (mesh_out)
-            fs_output_abort(mesh_out);
+        fs_output_abort(mesh_out);
+        fs_output_abort(asset_out);
         return -1;
     }
     if (mesh_out && fs_output_commit(mesh_out) < 0) {
+        free(written);
+        fs_output_abort(asset_out);
+        return -1;
+    }
+    if (asset_out && fs_output_commit(asset_out) < 0) {
         free(written);
         return -1;
     }
@@ -549,8 +578,8 @@ static int write_outputs(const options *o, const fs_config *cfg, const char *nam
         printf("%s/%s\n", o->output_dir, written->file[i]);
     free(written);
     printf("%s/%s\n", o->output_dir, json_name);
-    if (o->mesh_path)
-        printf("%s\n", o->mesh_path);
+    for (int i = 0; i < n_asset; i++)
+        printf("%s\n", asset_paths[i]);
     return 0;
 }
 
@@ -579,6 +608,14 @@ static int run(const char *preset_arg, const options *o)
             fs_model_name(cfg.preset.model), fs_domain_type_name(cfg.domain.type), (int)cfg.mesh.elements,
             cfg.preset.seed, cfg.render.width, cfg.render.height);
     free(preset_path);
+
+    /* --mesh and --asset paths may hold {name}, for batches */
+    options named = *o;
+    char *mesh_path = o->mesh_path ? fs_job_expand_name(o->mesh_path, name) : NULL;
+    char *asset_path = o->asset_path ? fs_job_expand_name(o->asset_path, name) : NULL;
+    named.mesh_path = mesh_path;
+    named.asset_path = asset_path;
+    o = &named;
 
     fs_result res;
     fs_raster raster = {0};
@@ -612,10 +649,42 @@ static int run(const char *preset_arg, const options *o)
     fs_raster_free(&raster);
     frame_writer_free(&fw);
     free(preset_text);
+    free(mesh_path);
+    free(asset_path);
     if (rc < 0)
         return fail();
-    fs_info("done in %.1f s", fs_seconds() - t_start);
+    char done[64];
+    snprintf(done, sizeof done, "done in %.1f s", fs_seconds() - t_start);
+    fs_progress_end(1, done);
+    fs_info("%s", done);
     return 0;
+}
+
+/* --job FILE:N: the run `fissure [OPTION]... -s SEED -n NAME --set OVERRIDE... PRESET` of job N,
+ * the job's overrides after the command line's. */
+static int run_job(options *o, int n_args)
+{
+    if (n_args > 0)
+        return usage_error("%s", "--job: the job names its preset; expected no PRESET argument");
+    if (o->have_seed || o->name)
+        return usage_error("--job: the job sets %s; expected no --seed or --name beside it",
+                           o->have_seed ? "the seed" : "the output name");
+    fs_job job;
+    if (fs_job_load(o->job, &job) < 0) {
+        if (fs_error_domain() == FS_ERR_USAGE)
+            return usage_error("%s", fs_error_message());
+        return fail();
+    }
+    o->have_seed = true;
+    o->seed = job.seed;
+    o->name = job.name;
+    o->sets = fs_realloc(o->sets, (size_t)(o->n_sets + job.n_sets + 1) * sizeof *o->sets);
+    for (int k = 0; k < job.n_sets; k++)
+        o->sets[o->n_sets++] = job.sets[k];
+    fs_debug("%s: job on line %d", o->job, job.line);
+    int rc = run(job.preset, o);
+    fs_jobs_free(&job, 1);
+    return rc;
 }
 
 int main(int argc, char **argv)
@@ -634,6 +703,15 @@ int main(int argc, char **argv)
     if (o.list_presets) {
         free(o.sets);
         return fs_preset_list(stdout) < 0 ? fail() : 0;
+    }
+    if (o.list_jobs) {
+        free(o.sets);
+        return fs_jobs_list(o.list_jobs, stdout) < 0 ? fail() : 0;
+    }
+    if (o.job) {
+        rc = run_job(&o, argc - optind);
+        free(o.sets);
+        return rc;
     }
     if (optind != argc - 1) {
         free(o.sets);

@@ -1,40 +1,40 @@
-/* The crack graph as JSON (jansson, as the sidecar) and as SVG (plain text). */
+/* The crack graph as JSON (io/json.h, as the sidecar) and as SVG (plain text). */
 #include "io/cracks.h"
 
 #include "config.h"
 
 #include <errno.h>
-#include <jansson.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/error.h"
+#include "io/json.h"
 
 static const char *const kind_names[] = {"junction", "end", "border"};
 
 /* Texture coordinates rounded to 1e-7 (a hundredth of a pixel up to 100000 pixels), so the file
  * holds short decimals rather than binary noise. */
-static json_t *coord(double x)
+static fs_json *coord(double x)
 {
-    return json_real(round(x * 1e7) / 1e7);
+    return fs_json_real(round(x * 1e7) / 1e7);
 }
 
-static json_t *uv_pair(const double *uv)
+static fs_json *uv_pair(const double *uv)
 {
-    json_t *a = json_array();
-    json_array_append_new(a, coord(uv[0]));
-    json_array_append_new(a, coord(uv[1]));
+    fs_json *a = fs_json_array();
+    fs_json_append(a, coord(uv[0]));
+    fs_json_append(a, coord(uv[1]));
     return a;
 }
 
-static json_t *node_ref(int32_t n)
+static fs_json *node_ref(int32_t n)
 {
-    return n >= 0 ? json_integer(n) : json_null();
+    return n >= 0 ? fs_json_integer(n) : fs_json_null();
 }
 
-static json_t *summary(const fs_crackgraph *g)
+static fs_json *summary(const fs_crackgraph *g)
 {
     int32_t counts[3] = {0, 0, 0}, max_degree = 0;
     for (int32_t i = 0; i < g->n_nodes; i++) {
@@ -42,18 +42,18 @@ static json_t *summary(const fs_crackgraph *g)
         if (g->node[i].degree > max_degree)
             max_degree = g->node[i].degree;
     }
-    json_t *s = json_object();
-    json_object_set_new(s, "junctions", json_integer(counts[FS_CRACK_JUNCTION]));
-    json_object_set_new(s, "ends", json_integer(counts[FS_CRACK_END]));
-    json_object_set_new(s, "border_ends", json_integer(counts[FS_CRACK_BORDER]));
-    json_object_set_new(s, "cracks", json_integer(g->n_edges));
-    json_object_set_new(s, "fragments", json_integer(g->n_fragments));
-    json_object_set_new(s, "adjacent_pairs", json_integer(g->n_adjacent));
+    fs_json *s = fs_json_object();
+    fs_json_set(s, "junctions", fs_json_integer(counts[FS_CRACK_JUNCTION]));
+    fs_json_set(s, "ends", fs_json_integer(counts[FS_CRACK_END]));
+    fs_json_set(s, "border_ends", fs_json_integer(counts[FS_CRACK_BORDER]));
+    fs_json_set(s, "cracks", fs_json_integer(g->n_edges));
+    fs_json_set(s, "fragments", fs_json_integer(g->n_fragments));
+    fs_json_set(s, "adjacent_pairs", fs_json_integer(g->n_adjacent));
     double length = 0.0;
     for (int32_t i = 0; i < g->n_edges; i++)
         length += g->edge[i].length;
-    json_object_set_new(s, "total_length_px", json_real(round(length * 100.0) / 100.0));
-    json_t *by_degree = json_object();
+    fs_json_set(s, "total_length_px", fs_json_real(round(length * 100.0) / 100.0));
+    fs_json *by_degree = fs_json_object();
     for (int32_t d = 3; d <= max_degree; d++) {
         int32_t n = 0;
         for (int32_t i = 0; i < g->n_nodes; i++)
@@ -61,69 +61,69 @@ static json_t *summary(const fs_crackgraph *g)
         if (n) {
             char key[16];
             snprintf(key, sizeof key, "%d", (int)d);
-            json_object_set_new(by_degree, key, json_integer(n));
+            fs_json_set(by_degree, key, fs_json_integer(n));
         }
     }
-    json_object_set_new(s, "junction_degrees", by_degree);
+    fs_json_set(s, "junction_degrees", by_degree);
     return s;
 }
 
-static json_t *edge_entry(const fs_crackgraph *g, int32_t i)
+static fs_json *edge_entry(const fs_crackgraph *g, int32_t i)
 {
     const fs_crack_edge *e = &g->edge[i];
-    json_t *o = json_object();
-    json_object_set_new(o, "id", json_integer(i));
+    fs_json *o = fs_json_object();
+    fs_json_set(o, "id", fs_json_integer(i));
     bool closed = e->node[0] < 0;
-    json_t *nodes = json_array();
-    json_array_append_new(nodes, node_ref(e->node[0]));
-    json_array_append_new(nodes, node_ref(e->node[1]));
-    json_object_set_new(o, "nodes", nodes);
-    json_object_set_new(o, "closed", json_boolean(closed));
-    json_object_set_new(o, "length_px", json_real(round(e->length * 100.0) / 100.0));
-    json_object_set_new(o, "width_px", json_real(round(e->width * 100.0) / 100.0));
-    json_object_set_new(o, "left", json_integer(e->left));
-    json_object_set_new(o, "right", json_integer(e->right));
-    json_t *pieces = json_array();
+    fs_json *nodes = fs_json_array();
+    fs_json_append(nodes, node_ref(e->node[0]));
+    fs_json_append(nodes, node_ref(e->node[1]));
+    fs_json_set(o, "nodes", nodes);
+    fs_json_set(o, "closed", fs_json_bool(closed));
+    fs_json_set(o, "length_px", fs_json_real(round(e->length * 100.0) / 100.0));
+    fs_json_set(o, "width_px", fs_json_real(round(e->width * 100.0) / 100.0));
+    fs_json_set(o, "left", fs_json_integer(e->left));
+    fs_json_set(o, "right", fs_json_integer(e->right));
+    fs_json *pieces = fs_json_array();
     for (int32_t k = e->first_piece; k < e->first_piece + e->n_pieces; k++) {
-        json_t *piece = json_array();
+        fs_json *piece = fs_json_array();
         for (int32_t q = g->piece_start[k]; q < g->piece_start[k + 1]; q++)
-            json_array_append_new(piece, uv_pair(g->point + 2 * q));
-        json_array_append_new(pieces, piece);
+            fs_json_append(piece, uv_pair(g->point + 2 * q));
+        fs_json_append(pieces, piece);
     }
-    json_object_set_new(o, "polylines", pieces);
+    fs_json_set(o, "polylines", pieces);
     return o;
 }
 
 /* Fragments with their neighbours, gathered per fragment from the adjacent pairs (sorted by a, b,
  * so each neighbour list comes out in increasing order). */
-static json_t *fragments(const fs_crackgraph *g)
+static fs_json *fragments(const fs_crackgraph *g)
 {
     int32_t *index = fs_malloc(65536 * sizeof *index);
     for (int i = 0; i < 65536; i++)
         index[i] = -1;
     for (int32_t i = 0; i < g->n_fragments; i++)
         index[g->fragment[i].id] = i;
-    json_t **nb = fs_calloc((size_t)g->n_fragments + 1, sizeof *nb);
+    fs_json **nb = fs_calloc((size_t)g->n_fragments + 1, sizeof *nb);
     for (int32_t i = 0; i < g->n_fragments; i++)
-        nb[i] = json_array();
+        nb[i] = fs_json_array();
     for (int pass = 0; pass < 2; pass++)
         for (int32_t k = 0; k < g->n_adjacent; k++) {
             const fs_crack_adjacency *a = &g->adjacent[k];
             int32_t ia = index[a->a], ib = index[a->b];
             if (pass == 0 && ib >= 0)
-                json_array_append_new(nb[ib], json_integer(a->a));
+                fs_json_append(nb[ib], fs_json_integer(a->a));
             if (pass == 1 && ia >= 0)
-                json_array_append_new(nb[ia], json_integer(a->b));
+                fs_json_append(nb[ia], fs_json_integer(a->b));
         }
-    json_t *list = json_array();
+    fs_json *list = fs_json_array();
     for (int32_t i = 0; i < g->n_fragments; i++) {
         const fs_crack_fragment *f = &g->fragment[i];
-        json_t *o = json_object();
-        json_object_set_new(o, "id", json_integer(f->id));
-        json_object_set_new(o, "area_px", json_integer(f->area));
-        json_object_set_new(o, "centroid", uv_pair(f->centroid));
-        json_object_set_new(o, "neighbours", nb[i]);
-        json_array_append_new(list, o);
+        fs_json *o = fs_json_object();
+        fs_json_set(o, "id", fs_json_integer(f->id));
+        fs_json_set(o, "area_px", fs_json_integer(f->area));
+        fs_json_set(o, "centroid", uv_pair(f->centroid));
+        fs_json_set(o, "neighbours", nb[i]);
+        fs_json_append(list, o);
     }
     free(nb);
     free(index);
@@ -132,51 +132,51 @@ static json_t *fragments(const fs_crackgraph *g)
 
 int fs_cracks_write_json(const char *path, const fs_crackgraph *g)
 {
-    json_t *root = json_object();
-    json_object_set_new(root, "generator", json_string("fissure"));
-    json_object_set_new(root, "version", json_string(PACKAGE_VERSION));
-    json_object_set_new(root, "width", json_integer(g->width));
-    json_object_set_new(root, "height", json_integer(g->height));
-    json_t *tile = json_object();
-    json_object_set_new(tile, "u", json_boolean(g->wrap_u));
-    json_object_set_new(tile, "v", json_boolean(g->wrap_v));
-    json_object_set_new(root, "tileable", tile);
-    json_object_set_new(root, "coordinates",
-                        json_string("texture space [u, v] in [0, 1], u to the right, v up; pixel (i, j) of the "
+    fs_json *root = fs_json_object();
+    fs_json_set(root, "generator", fs_json_string("fissure"));
+    fs_json_set(root, "version", fs_json_string(PACKAGE_VERSION));
+    fs_json_set(root, "width", fs_json_integer(g->width));
+    fs_json_set(root, "height", fs_json_integer(g->height));
+    fs_json *tile = fs_json_object();
+    fs_json_set(tile, "u", fs_json_bool(g->wrap_u));
+    fs_json_set(tile, "v", fs_json_bool(g->wrap_v));
+    fs_json_set(root, "tileable", tile);
+    fs_json_set(root, "coordinates",
+                        fs_json_string("texture space [u, v] in [0, 1], u to the right, v up; pixel (i, j) of the "
                                     "maps has its centre at ((i + 0.5) / width, 1 - (j + 0.5) / height). A "
                                     "polyline ending on a tileable edge continues as the next polyline of its "
                                     "crack from the opposite edge."));
-    json_object_set_new(root, "summary", summary(g));
+    fs_json_set(root, "summary", summary(g));
 
-    json_t *nodes = json_array();
+    fs_json *nodes = fs_json_array();
     for (int32_t i = 0; i < g->n_nodes; i++) {
-        json_t *o = json_object();
-        json_object_set_new(o, "id", json_integer(i));
-        json_object_set_new(o, "uv", uv_pair(g->node[i].uv));
-        json_object_set_new(o, "degree", json_integer(g->node[i].degree));
-        json_object_set_new(o, "kind", json_string(kind_names[g->node[i].kind]));
-        json_array_append_new(nodes, o);
+        fs_json *o = fs_json_object();
+        fs_json_set(o, "id", fs_json_integer(i));
+        fs_json_set(o, "uv", uv_pair(g->node[i].uv));
+        fs_json_set(o, "degree", fs_json_integer(g->node[i].degree));
+        fs_json_set(o, "kind", fs_json_string(kind_names[g->node[i].kind]));
+        fs_json_append(nodes, o);
     }
-    json_object_set_new(root, "nodes", nodes);
-    json_t *edges = json_array();
+    fs_json_set(root, "nodes", nodes);
+    fs_json *edges = fs_json_array();
     for (int32_t i = 0; i < g->n_edges; i++)
-        json_array_append_new(edges, edge_entry(g, i));
-    json_object_set_new(root, "cracks", edges);
-    json_object_set_new(root, "fragments", fragments(g));
-    json_t *adj = json_array();
+        fs_json_append(edges, edge_entry(g, i));
+    fs_json_set(root, "cracks", edges);
+    fs_json_set(root, "fragments", fragments(g));
+    fs_json *adj = fs_json_array();
     for (int32_t k = 0; k < g->n_adjacent; k++) {
-        json_t *o = json_object();
-        json_t *pair = json_array();
-        json_array_append_new(pair, json_integer(g->adjacent[k].a));
-        json_array_append_new(pair, json_integer(g->adjacent[k].b));
-        json_object_set_new(o, "fragments", pair);
-        json_object_set_new(o, "contact_px", json_integer(g->adjacent[k].contact));
-        json_array_append_new(adj, o);
+        fs_json *o = fs_json_object();
+        fs_json *pair = fs_json_array();
+        fs_json_append(pair, fs_json_integer(g->adjacent[k].a));
+        fs_json_append(pair, fs_json_integer(g->adjacent[k].b));
+        fs_json_set(o, "fragments", pair);
+        fs_json_set(o, "contact_px", fs_json_integer(g->adjacent[k].contact));
+        fs_json_append(adj, o);
     }
-    json_object_set_new(root, "adjacency", adj);
+    fs_json_set(root, "adjacency", adj);
 
-    int rc = json_dump_file(root, path, JSON_INDENT(1) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10));
-    json_decref(root);
+    int rc = fs_json_write(root, path, (fs_json_format){1, 10});
+    fs_json_free(root);
     if (rc != 0) {
         fs_error(FS_ERR_IO, "%s: cannot write the crack graph", path);
         return -1;

@@ -1,4 +1,4 @@
-/* Writers of the crack graph (render/crackgraph.h): NAME_cracks.json (jansson) and NAME_cracks.svg. */
+/* Writers of the crack graph (render/crackgraph.h): NAME_cracks.json (io/json.h) and NAME_cracks.svg. */
 #ifndef FS_IO_CRACKS_H
 #define FS_IO_CRACKS_H
 

@@ -105,7 +105,7 @@ static void put_group(writer *w, const fs_lifted_mesh *m, const char *group, int
     }
 }
 
-int fs_obj_write(const char *path, const fs_lifted_mesh *m, const char *name, const char *comment)
+int fs_obj_write(const char *path, const fs_lifted_mesh *m, const char *name, const char *comment, const char *mtllib)
 {
     FILE *f = fopen(path, "w");
     if (!f) {
@@ -128,7 +128,11 @@ int fs_obj_write(const char *path, const fs_lifted_mesh *m, const char *name, co
     fprintf(f, "# units: cm; texture v runs up the maps; faces counter-clockwise seen from outside\n"
                "# %d positions, %d texture vertices, %d normals, %d triangles (%d in walls)\n",
             (int)m->n_pos, (int)m->n_uv, (int)m->n_normal, (int)m->n_tris, (int)walls);
+    if (mtllib)
+        fprintf(f, "mtllib %s\n", mtllib);
     fprintf(f, "o %s\n", name);
+    if (mtllib)
+        fprintf(f, "usemtl %s\n", name);
     fflush(f);
     writer w = {f, fs_malloc((size_t)1 << 16), 0, (size_t)1 << 16};
     for (int32_t i = 0; i < m->n_pos; i++) {

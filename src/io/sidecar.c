@@ -3,11 +3,11 @@
 
 #include "config.h"
 
-#include <jansson.h>
 #include <stdbool.h>
 #include <string.h>
 
 #include "base/error.h"
+#include "io/json.h"
 #include "geom/domain.h"
 #include "io/preset.h"
 
@@ -24,13 +24,13 @@ static uint64_t fnv1a64(const char *s)
 
 static void visit_param(void *ctx, const char *section, const char *key, const char *value)
 {
-    json_t *params = ctx;
-    json_t *sec = json_object_get(params, section);
+    fs_json *params = ctx;
+    fs_json *sec = fs_json_get(params, section);
     if (!sec) {
-        sec = json_object();
-        json_object_set_new(params, section, sec);
+        sec = fs_json_object();
+        fs_json_set(params, section, sec);
     }
-    json_object_set_new(sec, key, json_string(value));
+    fs_json_set(sec, key, fs_json_string(value));
 }
 
 static int bit_depth(const fs_image *img)
@@ -43,52 +43,52 @@ static int bit_depth(const fs_image *img)
     return 0;
 }
 
-static json_t *map_entry(const fs_sidecar_map *m, const fs_config *cfg, const fs_maps *maps)
+static fs_json *map_entry(const fs_sidecar_map *m, const fs_config *cfg, const fs_maps *maps)
 {
     fs_domain d = cfg->domain;
     fs_domain_normalize(&d);
-    json_t *e = json_object();
-    json_object_set_new(e, "file", json_string(m->file));
+    fs_json *e = fs_json_object();
+    fs_json_set(e, "file", fs_json_string(m->file));
     if (m->usage)
-        json_object_set_new(e, "usage", json_string(m->usage));
+        fs_json_set(e, "usage", fs_json_string(m->usage));
     if (m->channels)
-        json_object_set_new(e, "channels_meaning", json_string(m->channels));
+        fs_json_set(e, "channels_meaning", fs_json_string(m->channels));
     if (!m->image)
         return e;
-    json_object_set_new(e, "color_space", json_string(m->color_space));
+    fs_json_set(e, "color_space", fs_json_string(m->color_space));
     if (m->image->type != FS_PIX_F32)
-        json_object_set_new(e, "png_color_chunk",
-                            json_string(!strcmp(m->color_space, "srgb") ? "sRGB" : "none (raw values)"));
-    json_object_set_new(e, "bit_depth", json_integer(bit_depth(m->image)));
-    json_object_set_new(e, "sample_format", json_string(m->image->type == FS_PIX_F32 ? "float" : "unsigned"));
-    json_object_set_new(e, "channels", json_integer(m->image->channels));
-    json_object_set_new(e, "width", json_integer(m->image->width));
-    json_object_set_new(e, "height", json_integer(m->image->height));
+        fs_json_set(e, "png_color_chunk",
+                            fs_json_string(!strcmp(m->color_space, "srgb") ? "sRGB" : "none (raw values)"));
+    fs_json_set(e, "bit_depth", fs_json_integer(bit_depth(m->image)));
+    fs_json_set(e, "sample_format", fs_json_string(m->image->type == FS_PIX_F32 ? "float" : "unsigned"));
+    fs_json_set(e, "channels", fs_json_integer(m->image->channels));
+    fs_json_set(e, "width", fs_json_integer(m->image->width));
+    fs_json_set(e, "height", fs_json_integer(m->image->height));
     /* a perspective view of the object never tiles, whatever the domain does */
     bool texture_space = strcmp(m->kind, "preview") != 0;
-    json_t *tile = json_object();
-    json_object_set_new(tile, "u", json_boolean(texture_space && fs_domain_wraps_u(&d)));
-    json_object_set_new(tile, "v", json_boolean(texture_space && fs_domain_wraps_v(&d)));
-    json_object_set_new(e, "tileable", tile);
+    fs_json *tile = fs_json_object();
+    fs_json_set(tile, "u", fs_json_bool(texture_space && fs_domain_wraps_u(&d)));
+    fs_json_set(tile, "v", fs_json_bool(texture_space && fs_domain_wraps_v(&d)));
+    fs_json_set(e, "tileable", tile);
     if (!strcmp(m->kind, "height")) {
-        json_object_set_new(e, "height_min_cm", json_real(maps->height_min_cm));
-        json_object_set_new(e, "height_max_cm", json_real(maps->height_max_cm));
-        json_object_set_new(e, "height_scale_cm", json_real(maps->height_max_cm - maps->height_min_cm));
-        json_object_set_new(e, "encoding", json_string(m->image->type == FS_PIX_F32
+        fs_json_set(e, "height_min_cm", fs_json_real(maps->height_min_cm));
+        fs_json_set(e, "height_max_cm", fs_json_real(maps->height_max_cm));
+        fs_json_set(e, "height_scale_cm", fs_json_real(maps->height_max_cm - maps->height_min_cm));
+        fs_json_set(e, "encoding", fs_json_string(m->image->type == FS_PIX_F32
                                                            ? "height in cm"
                                                            : "0 = height_min_cm, full scale = height_max_cm, linear"));
     } else if (!strcmp(m->kind, "normal")) {
-        json_object_set_new(e, "normal_convention",
-                            json_string(cfg->render.normal == FS_NORMAL_DIRECTX ? "directx" : "opengl"));
-        json_object_set_new(e, "height_scale", json_real(cfg->render.height_scale));
+        fs_json_set(e, "normal_convention",
+                            fs_json_string(cfg->render.normal == FS_NORMAL_DIRECTX ? "directx" : "opengl"));
+        fs_json_set(e, "height_scale", fs_json_real(cfg->render.height_scale));
     } else if (!strcmp(m->kind, "crackdist")) {
-        json_object_set_new(e, "units_per_pixel", json_real(maps->crackdist_scale));
+        fs_json_set(e, "units_per_pixel", fs_json_real(maps->crackdist_scale));
     } else if (!strcmp(m->kind, "cellid")) {
-        json_object_set_new(e, "encoding", json_string("fragment id, 0 = crack"));
+        fs_json_set(e, "encoding", fs_json_string("fragment id, 0 = crack"));
     } else if (!strcmp(m->kind, "crackmask")) {
-        json_object_set_new(e, "encoding", json_string("crack coverage, 255 = crack"));
+        fs_json_set(e, "encoding", fs_json_string("crack coverage, 255 = crack"));
     } else if (!strcmp(m->kind, "occlusion") || !strcmp(m->kind, "roughness")) {
-        json_object_set_new(e, "roughness", json_real(cfg->render.roughness));
+        fs_json_set(e, "roughness", fs_json_real(cfg->render.roughness));
     }
     return e;
 }
@@ -97,68 +97,68 @@ int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_
                      const fs_maps *maps, const char *target, const fs_sidecar_map *list, int n_maps,
                      const fs_sidecar_frames *frames, double wall_seconds)
 {
-    json_t *root = json_object();
-    json_object_set_new(root, "generator", json_string("fissure"));
-    json_object_set_new(root, "version", json_string(PACKAGE_VERSION));
+    fs_json *root = fs_json_object();
+    fs_json_set(root, "generator", fs_json_string("fissure"));
+    fs_json_set(root, "version", fs_json_string(PACKAGE_VERSION));
 
-    json_t *preset = json_object();
-    json_object_set_new(preset, "name", json_string(cfg->preset.name));
+    fs_json *preset = fs_json_object();
+    fs_json_set(preset, "name", fs_json_string(cfg->preset.name));
     if (preset_text) {
         char hash[32];
         snprintf(hash, sizeof hash, "fnv1a64:%016llx", (unsigned long long)fnv1a64(preset_text));
-        json_object_set_new(preset, "hash", json_string(hash));
+        fs_json_set(preset, "hash", fs_json_string(hash));
     }
-    json_object_set_new(root, "preset", preset);
-    json_object_set_new(root, "seed", json_integer((json_int_t)cfg->preset.seed));
+    fs_json_set(root, "preset", preset);
+    fs_json_set(root, "seed", fs_json_integer((int64_t)cfg->preset.seed));
 
-    json_t *params = json_object();
+    fs_json *params = fs_json_object();
     fs_preset_visit(cfg, visit_param, params);
-    json_object_set_new(root, "parameters", params);
+    fs_json_set(root, "parameters", params);
 
-    json_t *st = json_object();
-    json_object_set_new(st, "nodes", json_integer(stats->nodes));
-    json_object_set_new(st, "elements", json_integer(stats->elements));
-    json_object_set_new(st, "fractures", json_integer(stats->fractures));
-    json_object_set_new(st, "simulated_time", json_real(stats->simulated_time));
-    json_object_set_new(st, "wall_seconds", json_real(wall_seconds));
-    json_object_set_new(root, "stats", st);
+    fs_json *st = fs_json_object();
+    fs_json_set(st, "nodes", fs_json_integer(stats->nodes));
+    fs_json_set(st, "elements", fs_json_integer(stats->elements));
+    fs_json_set(st, "fractures", fs_json_integer(stats->fractures));
+    fs_json_set(st, "simulated_time", fs_json_real(stats->simulated_time));
+    fs_json_set(st, "wall_seconds", fs_json_real(wall_seconds));
+    fs_json_set(root, "stats", st);
 
-    json_object_set_new(root, "target", json_string(target));
-    json_t *jm = json_object();
+    fs_json_set(root, "target", fs_json_string(target));
+    fs_json *jm = fs_json_object();
     for (int i = 0; i < n_maps; i++)
-        json_object_set_new(jm, list[i].kind, map_entry(&list[i], cfg, maps));
-    json_object_set_new(root, "maps", jm);
+        fs_json_set(jm, list[i].kind, map_entry(&list[i], cfg, maps));
+    fs_json_set(root, "maps", jm);
 
     if (frames) {
-        json_t *jf = json_object();
-        json_object_set_new(jf, "count", json_integer(frames->count));
-        json_object_set_new(jf, "file_pattern", json_string(frames->file_pattern));
-        json_t *kinds = json_object();
+        fs_json *jf = fs_json_object();
+        fs_json_set(jf, "count", fs_json_integer(frames->count));
+        fs_json_set(jf, "file_pattern", fs_json_string(frames->file_pattern));
+        fs_json *kinds = fs_json_object();
         for (int i = 0; i < frames->n_maps; i++) {
-            json_t *e = map_entry(&frames->map[i], cfg, maps);
+            fs_json *e = map_entry(&frames->map[i], cfg, maps);
             /* each frame's height map has its own range, listed per frame below */
-            json_object_del(e, "height_min_cm");
-            json_object_del(e, "height_max_cm");
-            json_object_del(e, "height_scale_cm");
-            json_object_set_new(kinds, frames->map[i].kind, e);
+            fs_json_del(e, "height_min_cm");
+            fs_json_del(e, "height_max_cm");
+            fs_json_del(e, "height_scale_cm");
+            fs_json_set(kinds, frames->map[i].kind, e);
         }
-        json_object_set_new(jf, "maps", kinds);
-        json_t *list_f = json_array();
+        fs_json_set(jf, "maps", kinds);
+        fs_json *list_f = fs_json_array();
         for (int32_t k = 0; k < frames->count; k++) {
-            json_t *f = json_object();
-            json_object_set_new(f, "frame", json_integer(k + 1));
-            json_object_set_new(f, "time", json_real(frames->time[k]));
-            json_object_set_new(f, "fractures", json_integer(frames->fractures[k]));
-            json_object_set_new(f, "height_min_cm", json_real(frames->height_min_cm[k]));
-            json_object_set_new(f, "height_max_cm", json_real(frames->height_max_cm[k]));
-            json_array_append_new(list_f, f);
+            fs_json *f = fs_json_object();
+            fs_json_set(f, "frame", fs_json_integer(k + 1));
+            fs_json_set(f, "time", fs_json_real(frames->time[k]));
+            fs_json_set(f, "fractures", fs_json_integer(frames->fractures[k]));
+            fs_json_set(f, "height_min_cm", fs_json_real(frames->height_min_cm[k]));
+            fs_json_set(f, "height_max_cm", fs_json_real(frames->height_max_cm[k]));
+            fs_json_append(list_f, f);
         }
-        json_object_set_new(jf, "frames", list_f);
-        json_object_set_new(root, "frames", jf);
+        fs_json_set(jf, "frames", list_f);
+        fs_json_set(root, "frames", jf);
     }
 
-    int rc = json_dump_file(root, path, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10));
-    json_decref(root);
+    int rc = fs_json_write(root, path, (fs_json_format){2, 10});
+    fs_json_free(root);
     if (rc != 0) {
         fs_error(FS_ERR_IO, "%s: cannot write the sidecar", path);
         return -1;

@@ -1,4 +1,4 @@
-/* The JSON sidecar written beside the maps (jansson). */
+/* The JSON sidecar written beside the maps. */
 #ifndef FS_IO_SIDECAR_H
 #define FS_IO_SIDECAR_H
 

@@ -1,6 +1,7 @@
 /* Sparse symmetric assembly and products, and the only CHOLMOD user: sparse Cholesky for the equilibrium solves. */
 #include "solve/sparse.h"
 
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
@@ -165,6 +166,43 @@ void fs_sparse_matrix_free(fs_sparse_matrix *m)
     free(m->row_idx);
     free(m->values);
     memset(m, 0, sizeof *m);
+}
+
+bool fs_sparse_matrix_check(const fs_sparse_matrix *m, char *why, size_t len)
+{
+    char dummy[8];
+    if (!why) {
+        why = dummy;
+        len = sizeof dummy;
+    }
+    if (m->n < 0 || (m->n > 0 && (!m->col_ptr || m->col_ptr[0] != 0))) {
+        snprintf(why, len, "order %d, or col_ptr does not start at 0", (int)m->n);
+        return false;
+    }
+    for (int32_t j = 0; j < m->n; j++) {
+        int32_t p0 = m->col_ptr[j], p1 = m->col_ptr[j + 1];
+        if (p1 <= p0) {
+            snprintf(why, len, "column %d is empty (col_ptr %d, %d): no diagonal entry", (int)j, (int)p0, (int)p1);
+            return false;
+        }
+        for (int32_t p = p0; p < p1; p++) {
+            int32_t i = m->row_idx[p];
+            if (i < 0 || i > j || (p > p0 && i <= m->row_idx[p - 1])) {
+                snprintf(why, len, "column %d: row %d at entry %d is below the diagonal, out of range or out of order",
+                         (int)j, (int)i, (int)p);
+                return false;
+            }
+            if (!isfinite(m->values[p])) {
+                snprintf(why, len, "entry (%d, %d) is %g", (int)i, (int)j, m->values[p]);
+                return false;
+            }
+        }
+        if (m->row_idx[p1 - 1] != j) {
+            snprintf(why, len, "column %d does not end with its diagonal entry", (int)j);
+            return false;
+        }
+    }
+    return true;
 }
 
 void fs_sparse_matrix_zero(fs_sparse_matrix *m)

@@ -2,6 +2,7 @@
 #ifndef FS_SOLVE_SPARSE_H
 #define FS_SOLVE_SPARSE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -60,6 +61,13 @@ int fs_sparse_builder_compress(const fs_sparse_builder *b, fs_sparse_matrix *out
 
 /* Releases the arrays of m and zeroes the struct (a zeroed struct may be freed again). */
 void fs_sparse_matrix_free(fs_sparse_matrix *m);
+
+/* Checks the storage rules above: col_ptr starts at 0 and never decreases, every row index lies in
+ * [0, j] for column j and increases strictly down the column, every column ends with its diagonal
+ * entry, and every value is finite (so the symmetric matrix the upper triangle stands for is well
+ * defined). Returns true, or false with a message naming the column, row and value in why (len
+ * bytes; may be NULL). For --enable-validate builds and tests. */
+bool fs_sparse_matrix_check(const fs_sparse_matrix *m, char *why, size_t len);
 
 /* Number of stored entries (upper triangle including the diagonal). */
 static inline int32_t fs_sparse_matrix_nnz(const fs_sparse_matrix *m) { return m->col_ptr[m->n]; }

@@ -123,6 +123,8 @@ typedef struct {
     int32_t *anc_start;      /* n_nodes + 1: CSR node -> its anchors */
     int32_t *anc_list;
     int32_t *local_map;      /* n_nodes: index in the current local region, or -1 */
+    double *local_dist;      /* n_nodes: hops from the region's seeds while it grows (geom/region.h),
+                                INFINITY between growths */
     int32_t local_radius;    /* first graph radius (hops) of a local relaxation; <= 0 means 6 */
     double screening;        /* hops over which a local disturbance decays by e (<= 0: 3) */
     int32_t *seeds;          /* n_nodes scratch: nodes out of balance */

@@ -1,6 +1,8 @@
 /* Networks of point masses and springs relaxed to equilibrium: global inexact Newton on CHOLMOD, local conjugate gradients. */
 #include "model/springs/internal.h"
 
+#include "config.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,6 +10,7 @@
 #include "base/array.h"
 #include "base/error.h"
 #include "base/vec.h"
+#include "geom/region.h"
 #include "solve/cg.h"
 
 /* ==== the generic network ==== */
@@ -60,6 +63,7 @@ void fs_spring_net_free(fs_spring_net *net)
     free(net->anc_start);
     free(net->anc_list);
     free(net->local_map);
+    free(net->local_dist);
     free(net->seeds);
     memset(net, 0, sizeof *net);
 }
@@ -156,10 +160,14 @@ int fs_spring_net_prepare(fs_spring_net *net)
     net->anc_start = fs_calloc((size_t)n + 2, sizeof *net->anc_start);
     net->anc_list = fs_malloc(((size_t)net->n_anchors + 1) * sizeof *net->anc_list);
     net->local_map = fs_malloc(((size_t)n + 1) * sizeof *net->local_map);
+    free(net->local_dist);
+    net->local_dist = fs_malloc(((size_t)n + 1) * sizeof *net->local_dist);
     free(net->seeds);
     net->seeds = fs_malloc(((size_t)n + 1) * sizeof *net->seeds);
-    for (int32_t i = 0; i < n; i++)
+    for (int32_t i = 0; i < n; i++) {
         net->local_map[i] = -1;
+        net->local_dist[i] = INFINITY;
+    }
     for (int32_t s = 0; s < net->n_springs; s++) {
         net->adj_start[net->node[2 * s] + 1]++;
         net->adj_start[net->node[2 * s + 1] + 1]++;
@@ -215,6 +223,24 @@ static void spring_block(int dim, double k, double rest, const double *d, double
             H[p * dim + q] = k * ((1.0 - c) * nv[p] * nv[q] + (p == q ? c : 0.0));
 }
 
+/* Anchor a (its stiffness k not 0) at positions x: d = its node's position minus its point, *r2 = |d|^2;
+ * returns the factor g of its force -g d on the node: k, or k slide / |d| beyond the slide length
+ * (where the anchor pulls with a constant force). */
+static double anchor_pull(const fs_spring_net *net, int32_t a, const double *x, double d[3], double *r2)
+{
+    int dim = net->dim;
+    double k = net->anchor_k[a];
+    const double *xi = x + (size_t)dim * (size_t)net->anchor_node[a], *at = net->anchor_at + (size_t)dim * (size_t)a;
+    double s = 0.0;
+    for (int q = 0; q < dim; q++) {
+        d[q] = xi[q] - at[q];
+        s += d[q] * d[q];
+    }
+    *r2 = s;
+    double r = sqrt(s);
+    return net->slide > 0.0 && r > net->slide ? k * net->slide / r : k;
+}
+
 /* Energy and, when f is not NULL, the forces on the free unknowns, at positions x. Returns the
  * energy; *fmax (if not NULL) receives the largest node force norm. */
 static double net_eval(const fs_spring_net *net, const double *x, double *f, double *fmax)
@@ -249,19 +275,11 @@ static double net_eval(const fs_spring_net *net, const double *x, double *f, dou
         if (k == 0.0)
             continue;
         int32_t i = net->anchor_node[a];
-        const double *xi = x + (size_t)dim * (size_t)i, *at = net->anchor_at + (size_t)dim * (size_t)a;
-        double d[3], r2 = 0.0;
-        for (int q = 0; q < dim; q++) {
-            d[q] = xi[q] - at[q];
-            r2 += d[q] * d[q];
-        }
-        double r = sqrt(r2), g = k;
-        if (slide > 0.0 && r > slide) {
+        double d[3], r2, g = anchor_pull(net, a, x, d, &r2), r = sqrt(r2);
+        if (slide > 0.0 && r > slide)
             energy += k * slide * (r - slide) + 0.5 * k * slide * slide;
-            g = k * slide / r;
-        } else {
+        else
             energy += 0.5 * k * r2;
-        }
         int32_t di = net->dof[i];
         if (f && di >= 0)
             for (int q = 0; q < dim; q++)
@@ -364,6 +382,11 @@ static void net_assemble(fs_spring_net *net)
         eps = 1e-300;
     for (int32_t j = 0; j < net->K.n; j++)
         net->K.values[net->K.col_ptr[j + 1] - 1] += eps;
+#ifdef FS_VALIDATE
+    char why[256];
+    FS_INVARIANT(fs_sparse_matrix_check(&net->K, why, sizeof why), "springs network, after assembling the tangent: %s",
+                 why);
+#endif
 }
 
 /* Assembles and factorizes at the current state, remembering it for downdates. */
@@ -616,18 +639,9 @@ static void node_force(const fs_spring_net *net, int32_t i, const double *x, dou
     }
     for (int32_t p = net->anc_start[i]; p < net->anc_start[i + 1]; p++) {
         int32_t a = net->anc_list[p];
-        double k = net->anchor_k[a];
-        if (k == 0.0)
+        if (net->anchor_k[a] == 0.0)
             continue;
-        const double *xi = x + (size_t)dim * (size_t)i, *at = net->anchor_at + (size_t)dim * (size_t)a;
-        double d[3], r2 = 0.0;
-        for (int q = 0; q < dim; q++) {
-            d[q] = xi[q] - at[q];
-            r2 += d[q] * d[q];
-        }
-        double r = sqrt(r2), g = k;
-        if (net->slide > 0.0 && r > net->slide)
-            g = k * net->slide / r;
+        double d[3], r2, g = anchor_pull(net, a, x, d, &r2);
         for (int q = 0; q < dim; q++)
             out[q] -= g * d[q];
     }
@@ -643,9 +657,8 @@ static double norm_dim(const double *v, int dim)
 
 /* The region of a local relaxation and its scratch. */
 typedef struct {
-    int32_t n, cap;          /* region nodes */
-    int32_t *nodes;
-    int32_t *depth;
+    int32_t n;               /* region nodes */
+    int32_t *nodes;          /* n_nodes entries */
     int32_t ns, cap_s;       /* springs with an end in the region (each once), intact */
     int32_t *springs;
     double *H;               /* dim * dim per region spring */
@@ -661,37 +674,38 @@ static void region_clear(fs_spring_net *net, local_region *g)
     g->ns = 0;
 }
 
-static void region_push(fs_spring_net *net, local_region *g, int32_t node, int32_t depth)
+/* fs_region_edges_fn of a spring network: the intact springs of node i to free nodes, one hop each,
+ * in the order of its adjacency. */
+static void intact_springs(void *ctx, int32_t i, fs_region *r)
 {
-    if (FS_ARRAY_GROW(g->cap, g->n + 1, 256)) {
-        FS_ARRAY_RESIZE(g->nodes, g->cap);
-        FS_ARRAY_RESIZE(g->depth, g->cap);
+    const fs_spring_net *net = ctx;
+    for (int32_t p = net->adj_start[i]; p < net->adj_start[i + 1]; p++) {
+        int32_t s = net->adj_spring[p];
+        if (net->k[s] == 0.0)
+            continue;
+        int32_t j = net->node[2 * s] == i ? net->node[2 * s + 1] : net->node[2 * s];
+        if (net->dof[j] >= 0)
+            fs_region_reach(r, j, 1.0);
     }
-    net->local_map[node] = g->n;
-    g->nodes[g->n] = node;
-    g->depth[g->n++] = depth;
 }
 
-/* Breadth-first over intact springs from the seeds to the given depth, free nodes only. */
+/* Breadth-first over intact springs from the seeds to the given depth, free nodes only (geom/region.h
+ * with one hop per spring, ties by arrival: the nodes in the order of a breadth-first queue). */
 static void region_grow(fs_spring_net *net, local_region *g, const int32_t *seeds, int32_t n_seeds, int32_t radius)
 {
     region_clear(net, g);
+    int32_t *free_seeds = fs_malloc(((size_t)n_seeds + 1) * sizeof *free_seeds), n_free = 0;
     for (int32_t k = 0; k < n_seeds; k++)
-        if (net->dof[seeds[k]] >= 0 && net->local_map[seeds[k]] < 0)
-            region_push(net, g, seeds[k], 0);
-    for (int32_t head = 0; head < g->n; head++) {
-        int32_t i = g->nodes[head], dep = g->depth[head];
-        if (dep >= radius)
-            continue;
-        for (int32_t p = net->adj_start[i]; p < net->adj_start[i + 1]; p++) {
-            int32_t s = net->adj_spring[p];
-            if (net->k[s] == 0.0)
-                continue;
-            int32_t j = net->node[2 * s] == i ? net->node[2 * s + 1] : net->node[2 * s];
-            if (net->local_map[j] < 0 && net->dof[j] >= 0)
-                region_push(net, g, j, dep + 1);
-        }
-    }
+        if (net->dof[seeds[k]] >= 0)
+            free_seeds[n_free++] = seeds[k];
+    if (!g->nodes)
+        g->nodes = fs_malloc(((size_t)net->n_nodes + 1) * sizeof *g->nodes);
+    g->n = fs_region_grow(free_seeds, n_free, radius, FS_REGION_TIES_BY_ARRIVAL, intact_springs, net, net->local_dist,
+                          g->nodes);
+    fs_region_forget(net->local_dist, g->nodes, g->n);
+    for (int32_t k = 0; k < g->n; k++)
+        net->local_map[g->nodes[k]] = k;
+    free(free_seeds);
     for (int32_t k = 0; k < g->n; k++) {
         int32_t i = g->nodes[k];
         for (int32_t p = net->adj_start[i]; p < net->adj_start[i + 1]; p++) {
@@ -719,7 +733,6 @@ static void region_free(fs_spring_net *net, local_region *g)
 {
     region_clear(net, g);
     free(g->nodes);
-    free(g->depth);
     free(g->springs);
     free(g->H);
     free(g->P);

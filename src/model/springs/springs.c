@@ -1,6 +1,8 @@
 /* The springs model: the mass-spring network of thesis ch. 4 on a mesh, growth and shrinkage, and fracture in time. */
 #include "model/springs/internal.h"
 
+#include "config.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -171,6 +173,13 @@ static int relax_current(fs_springs *s)
     fs_spring_relax_info info;
     int rc = fs_spring_net_relax_auto(&s->net, tolerance(s), &info);
     s->relax_steps += info.iterations;
+#ifdef FS_VALIDATE
+    if (rc == 0) {
+        int64_t bad = fs_first_nonfinite(s->net.x, (size_t)s->net.n_nodes * (size_t)s->net.dim);
+        FS_INVARIANT(bad < 0, "springs model, after an equilibrium at time %g: coordinate %d of node %d is %g", s->time,
+                     (int)(bad % s->net.dim), (int)(bad / s->net.dim), s->net.x[bad]);
+    }
+#endif
     return rc;
 }
 

@@ -93,7 +93,7 @@ typedef struct {
 /* The coupling K_fb of the free DOFs with the fixed ones: one column per fixed DOF (its index minus
  * n_free), holding its free rows strictly ascending with their values. A column lives in
  * row[start .. start + len) with room up to start + cap, so a cut adds entries in place; a full column
- * moves to the end of the pool (see coupling_insert in wedge.c). Fixed indices and free rows keep
+ * moves to the end of the pool (see fs_wedge_coupling_insert in system.c). Fixed indices and free rows keep
  * their numbers when nodes are added (number_dofs), so no column ever shifts. */
 typedef struct {
     int32_t n;                   /* columns (n_fixed) */
@@ -139,14 +139,14 @@ struct fs_wedge_model {
                                     stress at the three top Gauss points over the threshold, or an
                                     upper bound of it; exact for the largest ratio and every ratio that
                                     ties with it when that is over 1 (what fracture decides on, see
-                                    wedge.c); NaN when not alive. fs_wedge_element_ratio is exact. */
+                                    equilibrium.c); NaN when not alive. fs_wedge_element_ratio is exact. */
     double *stress_top;          /* 18 per element: Voigt stress (MPa) at the top Gauss points 0..2;
                                     with lazy_ratios, as of the element's last full evaluation */
-    double *gauss_cache;         /* 108 per element: geometry terms of the stress check (wedge.c) */
+    double *gauss_cache;         /* 108 per element: geometry terms of the stress check (FS_WEDGE_GAUSS_CACHE) */
     double *edge_rest;           /* 3 per living element: length (cm) of its edge c (corners c and
                                     c + 1) in the surface mesh at rest, set with gauss_cache */
     bool lazy_ratios;            /* re-evaluate at the same time only the elements whose ratio bound
-                                    could have reached 1 (wedge.c, element_ratios); on for
+                                    could have reached 1 (equilibrium.c, fs_wedge_element_ratios); on for
                                     element removal (fs_wedge_init) */
     double *node_ratio;          /* per node: the nodal ratio of the split criterion at the current
                                     stresses (wedge/split.c), or only an upper bound of it where
@@ -294,7 +294,7 @@ double fs_wedge_max_ratio(const fs_wedge_model *w);
 double fs_wedge_element_ratio(const fs_wedge_model *w, int32_t e);
 
 /* Element geometry at the current time: x[18] node coordinates in the model's frame (bottom nodes
- * 0..2, top 3..5, see wedge_element.h), unwrapped across periodic seams. */
+ * 0..2, top 3..5, see wedge/element.h), unwrapped across periodic seams. */
 void fs_wedge_element_coords(const fs_wedge_model *w, int32_t e, double x[18]);
 
 /* Stress (Voigt, MPa) of a living element at natural point (r, s, zeta), at the current equilibrium,
@@ -508,8 +508,69 @@ void fs_wedge_prescribe_fixed(fs_wedge_model *w);
  * with fs_error. */
 int fs_wedge_update_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n);
 
+/* ---- --enable-validate (base/error.h: FS_INVARIANT) ---- */
+
+/* Each aborts, naming the broken invariant and `after` (the step just done), unless it holds:
+ * the mesh: fs_mesh_check (manifold, consistently oriented, valid adjacency) and as many elements as
+ * triangles; the system: K_ff a consistent upper triangle with finite values (fs_sparse_matrix_check),
+ * of order n_free; the state: finite displacements of every node and finite top stresses of every
+ * living element. Called from #ifdef FS_VALIDATE blocks after every mesh change, assembly and
+ * equilibrium. */
+void fs_wedge_check_mesh(const fs_wedge_model *w, const char *after);
+void fs_wedge_check_system(const fs_wedge_model *w, const char *after);
+void fs_wedge_check_state(const fs_wedge_model *w, const char *after);
+
 /* Fragment label of every element (-1 for removed ones, else 0 .. count-1 numbered by their smallest
  * element); returns the count. labels has n_elems entries. */
 int32_t fs_wedge_fragments(const fs_wedge_model *w, int32_t *labels);
+
+/* ---- shared by the model's own files (wedge.c, system.c, equilibrium.c, change.c) ---- */
+
+/* Doubles per element of gauss_cache, what the stress check needs at the three top Gauss points:
+ * dN/dx (3 x 18) and the strains of the three shrinkage patterns (3 x 3 x 6), so that a stress costs
+ * a few hundred flops. Valid while the element's geometry is: refreshed on assembly, thickness change
+ * and subdivision (equilibrium.c). */
+#define FS_WEDGE_GAUSS_CACHE 108
+
+/* wedge.c: geometry and arrays. The layer's base thickness at time t (cm); element e's 18 node
+ * coordinates at a base thickness (bottom nodes, then tops along their normals, unwrapped); the unit
+ * displacement patterns whose combinations give an element's loads (three of shrinkage, three of
+ * eigenstrain, see wedge.c); the reference-shape displacement at the current shrinkage; the node and
+ * element arrays grown to n_nodes and n_elems (new entries initialised). */
+double fs_wedge_layer_thickness(const fs_wedge_model *w, double t);
+void fs_wedge_coords_at(const fs_wedge_model *w, int32_t e, double base_thickness, double x[18]);
+void fs_wedge_patterns(const double x[18], double pat[FS_WEDGE_PATTERNS][18]);
+void fs_wedge_shrink_displacement(const fs_wedge_model *w, const double x[18], double u0[18]);
+void fs_wedge_grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems);
+
+/* system.c: the global system. DOF numbering (free first, in node order), the DOF of element e's
+ * node a (0..5), the node element lists (built, or updated after a change: see system.c), the living
+ * elements at node i, element e's stiffness and unit loads, the slot of entry (i, j) of an upper CSC
+ * matrix (-1 if absent), the coupling's column operations, the whole assembly, re-adding elements into
+ * the pattern (only the marked DOFs' entries when only is not NULL), new values on the same pattern,
+ * and the CHOLMOD factorization (with a new analysis when analyze is set). Return 0 or -1 with
+ * fs_error where they return int. */
+void fs_wedge_number_dofs(fs_wedge_model *w);
+int32_t fs_wedge_elem_dof(const fs_wedge_model *w, int32_t e, int a);
+void fs_wedge_build_node_elems(fs_wedge_model *w);
+void fs_wedge_update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const int32_t *changed, int32_t n_changed,
+                                const int32_t *lost, int32_t nl);
+int32_t fs_wedge_alive_at_node(const fs_wedge_model *w, int32_t i);
+int fs_wedge_element_system(const fs_wedge_model *w, int32_t e, double base_thickness, double K[324],
+                            double loads[FS_WEDGE_PATTERNS][18]);
+int32_t fs_wedge_find_entry(const fs_sparse_matrix *m, int32_t i, int32_t j);
+void fs_wedge_coupling_free(fs_wedge_coupling *c);
+void fs_wedge_coupling_resize(fs_wedge_coupling *c, int32_t n);
+void fs_wedge_coupling_insert(fs_wedge_coupling *c, int32_t k, int32_t row);
+void fs_wedge_coupling_compact(fs_wedge_coupling *c);
+int fs_wedge_build_system(fs_wedge_model *w);
+int fs_wedge_readd(fs_wedge_model *w, const int32_t *elems, int32_t n, const uint8_t *only);
+int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness);
+int fs_wedge_factorize(fs_wedge_model *w, bool analyze);
+
+/* equilibrium.c: the element caches of the stress check (gauss_cache, edge_rest) of the listed
+ * elements, and their stresses and ratios (see the ratio field). Return 0 or -1 with fs_error. */
+int fs_wedge_refresh_cache(fs_wedge_model *w, const int32_t *elems, int32_t n);
+int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_elems);
 
 #endif

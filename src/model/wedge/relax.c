@@ -3,10 +3,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "config.h"
 #include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/sort.h"
+#include "geom/region.h"
 #include "model/wedge/internal.h"
 #include "solve/cg.h"
 #include "solve/sparse.h"
@@ -21,55 +23,6 @@ typedef struct {
     int32_t *v;
     int32_t n;
 } ilist_t;
-
-/* ---- a binary min-heap of (distance, node), ties by node index ---- */
-
-typedef struct {
-    double d;
-    int32_t node;
-} heap_item;
-
-typedef struct {
-    heap_item *a;
-    int32_t n, cap;
-} heap;
-
-static bool heap_less(heap_item x, heap_item y)
-{
-    return x.d < y.d || (x.d == y.d && x.node < y.node);
-}
-
-static void heap_push(heap *h, double d, int32_t node)
-{
-    FS_ARRAY_RESERVE(h->a, h->cap, h->n + 1, 256);
-    int32_t i = h->n++;
-    heap_item it = {d, node};
-    while (i > 0 && heap_less(it, h->a[(i - 1) / 2])) {
-        h->a[i] = h->a[(i - 1) / 2];
-        i = (i - 1) / 2;
-    }
-    h->a[i] = it;
-}
-
-static heap_item heap_pop(heap *h)
-{
-    heap_item top = h->a[0], last = h->a[--h->n];
-    int32_t i = 0;
-    for (;;) {
-        int32_t c = 2 * i + 1;
-        if (c >= h->n)
-            break;
-        if (c + 1 < h->n && heap_less(h->a[c + 1], h->a[c]))
-            c++;
-        if (!heap_less(h->a[c], last))
-            break;
-        h->a[i] = h->a[c];
-        i = c;
-    }
-    if (h->n > 0)
-        h->a[i] = last;
-    return top;
-}
 
 /* ---- residual ---- */
 
@@ -130,49 +83,33 @@ double fs_wedge_mean_edge(const fs_wedge_model *w)
     return count ? sum / (double)count : 1.0;
 }
 
-/* Dijkstra from the seed nodes (dist 0) along the edges of living elements at rest, up to radius:
- * every node reached gets its distance in dist (INFINITY elsewhere) and is appended to out, which
- * receives the seeds first. Returns the number of nodes in out. */
+/* fs_region_edges_fn of the wedge model: the edges of node i's living elements, by their length at
+ * rest, element by element in node_elem's order, corners in order. */
+static void living_edges(void *ctx, int32_t i, fs_region *r)
+{
+    const fs_wedge_model *w = ctx;
+    for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++) {
+        int32_t e = w->node_elem[p];
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        const int32_t *tri = w->mesh->tri + 3 * (size_t)e;
+        int ci = 0;
+        while (ci < 3 && tri[ci] != i)
+            ci++;
+        FS_ASSERT(ci < 3);
+        for (int c = 0; c < 3; c++)
+            if (tri[c] != i)
+                fs_region_reach(r, tri[c], edge_length(w, e, ci, c));
+    }
+}
+
+/* Dijkstra from the seed nodes along the edges of living elements at rest, up to radius (geom/region.h,
+ * ties by node index): every node reached gets its distance in dist (INFINITY on entry) and is
+ * appended to out, which receives the seeds first. Returns the number of nodes in out. */
 static int32_t grow_region(const fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds, double radius,
                            double *dist, int32_t *out)
 {
-    heap h = {0};
-    int32_t n_out = 0;
-    for (int32_t q = 0; q < n_seeds; q++) {
-        dist[seeds[q]] = 0.0;
-        out[n_out++] = seeds[q];
-        heap_push(&h, 0.0, seeds[q]);
-    }
-    while (h.n > 0) {
-        heap_item it = heap_pop(&h);
-        int32_t i = it.node;
-        if (it.d > dist[i])
-            continue;
-        for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++) {
-            int32_t e = w->node_elem[p];
-            if (w->state[e] != FS_WEDGE_ALIVE)
-                continue;
-            const int32_t *tri = w->mesh->tri + 3 * (size_t)e;
-            int ci = 0;
-            while (ci < 3 && tri[ci] != i)
-                ci++;
-            FS_ASSERT(ci < 3);
-            for (int c = 0; c < 3; c++) {
-                int32_t j = tri[c];
-                if (j == i)
-                    continue;
-                double d = it.d + edge_length(w, e, ci, c);
-                if (d <= radius && d < dist[j]) {
-                    if (dist[j] == INFINITY)
-                        out[n_out++] = j;
-                    dist[j] = d;
-                    heap_push(&h, d, j);
-                }
-            }
-        }
-    }
-    free(h.a);
-    return n_out;
+    return fs_region_grow(seeds, n_seeds, radius, FS_REGION_TIES_BY_NODE, living_edges, (void *)w, dist, out);
 }
 
 int32_t fs_wedge_relax_region(const fs_wedge_model *w, const int32_t *seeds, int32_t n, double radius, int32_t *out)
@@ -180,16 +117,7 @@ int32_t fs_wedge_relax_region(const fs_wedge_model *w, const int32_t *seeds, int
     double *dist = fs_malloc(((size_t)w->n_nodes + 1) * sizeof *dist);
     for (int32_t i = 0; i < w->n_nodes; i++)
         dist[i] = INFINITY;
-    int32_t *unique = fs_malloc(((size_t)n + 1) * sizeof *unique), m = 0;
-    for (int32_t q = 0; q < n; q++)
-        if (dist[seeds[q]] != 0.0) {
-            dist[seeds[q]] = 0.0;
-            unique[m++] = seeds[q];
-        }
-    for (int32_t q = 0; q < m; q++)
-        dist[unique[q]] = INFINITY;
-    int32_t count = grow_region(w, unique, m, radius, dist, out);
-    free(unique);
+    int32_t count = grow_region(w, seeds, n, radius, dist, out);
     free(dist);
     return count;
 }
@@ -458,6 +386,10 @@ static int relax_region(fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds
     free(x_before);
     free(map);
     free(region);
+#ifdef FS_VALIDATE
+    if (rc == 0)
+        fs_wedge_check_state(w, "a local relaxation");
+#endif
     return rc;
 }
 

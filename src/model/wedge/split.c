@@ -9,6 +9,7 @@
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "fracture/rank.h"
+#include "fracture/separation.h"
 #include "fracture/split.h"
 #include "geom/cut.h"
 #include "geom/refine.h"
@@ -100,15 +101,13 @@ static void stress_at(const stresses *st, int32_t e, int c, double out[6])
 /* Ratio of the top Gauss point of element e nearest corner c, and its principal direction. */
 static double point_ratio(const fs_wedge_model *w, const stresses *st, int32_t e, int c, double m[3])
 {
-    double sigma[3], dirs[9], v[6];
+    double sigma1, v[6];
     stress_at(st, e, c, v);
-    if (fs_eigen_principal_stress(v, sigma, m ? dirs : NULL) < 0) {
+    if (fs_nodal_principal_plane(v, &sigma1, m) < 0) {
         fs_error_clear();
         return -INFINITY;
     }
-    if (m)
-        memcpy(m, dirs, 3 * sizeof *m);
-    return sigma[0] / w->threshold[e];
+    return sigma1 / w->threshold[e];
 }
 
 /* Ratio at crack tip i: the largest over its elements of the ratio at the top Gauss point nearest the
@@ -137,10 +136,8 @@ static double tip_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t 
  * without a living element. */
 static bool node_mean_stress(const fs_wedge_model *w, const stresses *st, int32_t i, double s[6], double *thr)
 {
+    fs_nodal_stress mean = {{0.0}, 0};
     double sum = 0.0;
-    int count = 0;
-    for (int k = 0; k < 6; k++)
-        s[k] = 0.0;
     for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++) {
         int32_t e = w->node_elem[p];
         if (w->state[e] != FS_WEDGE_ALIVE)
@@ -148,16 +145,12 @@ static bool node_mean_stress(const fs_wedge_model *w, const stresses *st, int32_
         int c = fs_mesh_corner_of(w->mesh, e, i);
         double v[6];
         stress_at(st, e, c, v);
-        for (int k = 0; k < 6; k++)
-            s[k] += v[k];
+        fs_nodal_stress_add(&mean, v);
         sum += w->threshold[e];
-        count++;
     }
-    if (count == 0)
+    if (!fs_nodal_stress_mean(&mean, s))
         return false;
-    for (int k = 0; k < 6; k++)
-        s[k] /= count;
-    *thr = sum / count;
+    *thr = sum / mean.count;
     return true;
 }
 
@@ -166,17 +159,14 @@ static bool node_mean_stress(const fs_wedge_model *w, const stresses *st, int32_
  * without a living element or with a non-finite stress. */
 static double node_ratio_of(const fs_wedge_model *w, const stresses *st, int32_t i, double m[3])
 {
-    double s[6], thr;
+    double s[6], thr, sigma1;
     if (!node_mean_stress(w, st, i, s, &thr))
         return -INFINITY;
-    double sigma[3], dirs[9];
-    if (fs_eigen_principal_stress(s, sigma, m ? dirs : NULL) < 0) {
+    if (fs_nodal_principal_plane(s, &sigma1, m) < 0) {
         fs_error_clear();
         return -INFINITY;
     }
-    if (m)
-        memcpy(m, dirs, 3 * sizeof *m);
-    return sigma[0] / thr;
+    return sigma1 / thr;
 }
 
 /* An upper bound of node_ratio_of(w, st, i, NULL), tight where it exceeds level (see

@@ -9,6 +9,7 @@
 #include "base/sort.h"
 #include "base/vec.h"
 #include "fracture/eigen.h"
+#include "fracture/separation.h"
 #include "geom/refine.h"
 #include "model/wedge/internal.h"
 #include "model/wedge/frame.h"
@@ -141,12 +142,10 @@ static int nodal_ratio(const fs_wedge_model *w, int32_t node, double *ratio, dou
     for (int32_t p = w->node_elem_start[node]; p < w->node_elem_start[node] + w->node_elem_count[node]; p++)
         if (w->state[w->node_elem[p]] == FS_WEDGE_ALIVE)
             thr += w->threshold[w->node_elem[p]];
-    double sigma[3], dirs[9];
-    if (fs_eigen_principal_stress(s, sigma, dirs) < 0)
+    double sigma1;
+    if (fs_nodal_principal_plane(s, &sigma1, m) < 0)
         return -1;
-    *ratio = sigma[0] / (thr / count);
-    if (m)
-        memcpy(m, dirs, 3 * sizeof *m);
+    *ratio = sigma1 / (thr / count);
     return 0;
 }
 

@@ -1,0 +1,544 @@
+/* The wedge model's equilibrium: the right-hand side, the solve, stresses and fracture ratios, snapshots and their blend (thesis §5.5-5.6). */
+#include "model/wedge/internal.h"
+
+#include "config.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "base/log.h"
+#include "base/vec.h"
+#include "fracture/eigen.h"
+#include "fracture/rank.h"
+#include "fracture/separation.h"
+#include "model/wedge/element.h"
+#include "solve/cg.h"
+
+/* ---- equilibrium ---- */
+
+/* Displacement of the fixed DOFs at time t: the prescribed values plus the growth motion of the
+ * bottom nodes (moving mode). */
+static void fixed_displacements(fs_wedge_model *w, double t)
+{
+    const fs_mesh *m = w->mesh;
+    for (int32_t j = 0; j < w->n_fixed; j++) {
+        int32_t nd = w->fixed_node_dof[j];
+        w->u_fixed[j] = w->prescribed[nd];
+    }
+    if (w->growth_mode != FS_WEDGE_GROWTH_MOVE)
+        return;
+    for (int32_t i = 0; i < w->n_nodes; i++) {
+        const double *p = m->pos + 3 * (size_t)i;
+        double q[3];
+        fs_growth_flow(&w->growth, p, 0.0, t, q);
+        for (int k = 0; k < 3; k++) {
+            int32_t g = w->dof[6 * (size_t)i + k];
+            w->u_fixed[g - w->n_free] += q[k] - p[k];
+        }
+    }
+}
+
+void fs_wedge_build_rhs(fs_wedge_model *w)
+{
+    int32_t nf = w->n_free;
+    double coef[FS_WEDGE_PATTERNS];
+    fs_wedge_load_coefficients(w, coef);
+    for (int32_t i = 0; i < nf; i++) {
+        double s = 0.0;
+        for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
+            s += coef[q] * w->load[FS_WEDGE_PATTERNS * (size_t)i + q];
+        w->rhs[i] = s;
+    }
+    const fs_wedge_coupling *c = &w->k_fb;
+    for (int32_t k = 0; k < c->n; k++) {
+        double uk = w->u_fixed[k];
+        if (uk == 0.0)
+            continue;
+        for (int32_t p = c->start[k]; p < c->start[k] + c->len[k]; p++)
+            w->rhs[c->row[p]] -= c->value[p] * uk;
+    }
+}
+
+/* Scales the starting guess w->x of a CG solve by the factor that minimises the energy along it,
+ * (x . b) / (x . K x): the previous displacements fit the new loads exactly when those are the old ones
+ * times a factor (shrinkage and isogonic growth from a common start), and closely when nearly so. */
+static void scale_guess(fs_wedge_model *w)
+{
+    int32_t n = w->n_free;
+    double *kx = fs_malloc((size_t)n * sizeof *kx);
+    fs_sparse_matvec(&w->k_free, w->x, kx);
+    double xb = 0.0, xkx = 0.0;
+    for (int32_t i = 0; i < n; i++) {
+        xb += w->x[i] * w->rhs[i];
+        xkx += w->x[i] * kx[i];
+    }
+    free(kx);
+    if (xkx > 0.0 && isfinite(xb / xkx))
+        for (int32_t i = 0; i < n; i++)
+            w->x[i] *= xb / xkx;
+}
+
+/* design: with local relaxation (thesis §5.8) the mesh changes at nearly every event and the factor
+ * is dropped (fs_wedge_apply_change); re-analysing and re-factorizing it for each global solve cost
+ * 5-10 times a conjugate-gradient solve started from the current displacements, which are close to
+ * the answer (the layer is well conditioned: every wedge's bottom is held). So a global solve with
+ * a stale factor is done by CG to solver.tolerance; the factor is rebuilt only when the mesh has not
+ * changed since (fs_wedge_refactor). */
+static int solve(fs_wedge_model *w)
+{
+    double t0 = fs_seconds();
+    int rc = 0;
+    if (w->n_free == 0) {
+    } else if (w->cfg.solver.method == FS_SOLVER_CHOLMOD && !w->factor_stale) {
+        rc = fs_cholesky_solve(w->chol, 1, w->rhs, w->x);
+    } else {
+        fs_cg_params p = fs_cg_params_default();
+        p.tolerance = w->cfg.solver.tolerance;
+        p.max_iterations = w->cfg.solver.max_iterations;
+        if (w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
+            /* the CG baseline stays the thesis's: Jacobi, from the previous displacements */
+            scale_guess(w);
+            p.block = 3; /* a node's three unknowns are consecutive (number_dofs) */
+        }
+        int it = fs_cg_solve(&w->k_free, w->rhs, w->x, p, NULL);
+        if (it >= 0) {
+            w->counters.cg_iterations += it;
+        } else if (w->cfg.solver.method == FS_SOLVER_CHOLMOD) {
+            /* CG can stall on a mesh that many cuts have left ill-conditioned: a fresh analysis (the
+             * pattern has changed since the factor) and factorization, and the direct solve */
+            fs_debug("wedge: %s; solving with a fresh factorization", fs_error_message());
+            fs_error_clear();
+            rc = fs_wedge_factorize(w, true);
+            if (rc == 0)
+                rc = fs_cholesky_solve(w->chol, 1, w->rhs, w->x);
+        } else {
+            rc = -1;
+        }
+    }
+    w->counters.solves++;
+    w->counters.solve_seconds += fs_seconds() - t0;
+    return rc;
+}
+
+static void gather_u(const fs_wedge_model *w, int32_t e, double ue[18])
+{
+    const int32_t *tri = w->mesh->tri + 3 * (size_t)e;
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 3; k++) {
+            ue[3 * c + k] = w->u[6 * (size_t)tri[c] + k];
+            ue[3 * (c + 3) + k] = w->u[6 * (size_t)tri[c] + 3 + k];
+        }
+}
+
+/* Stress from a strain net of the eigenstrain: sigma = E D1 (strain - eps0). */
+static void stress_of(const fs_wedge_model *w, int32_t e, const double strain[6], double stress[6])
+{
+    double eps[6] = {strain[0] - w->eigenstrain[0], strain[1] - w->eigenstrain[1], strain[2],
+                     strain[3] - w->eigenstrain[2], strain[4], strain[5]};
+    for (int i = 0; i < 6; i++) {
+        double s = 0.0;
+        for (int j = 0; j < 6; j++)
+            s += w->d_unit[6 * i + j] * eps[j];
+        stress[i] = w->young[e] * s;
+    }
+}
+
+int fs_wedge_element_stress(const fs_wedge_model *w, int32_t e, double r, double s, double zeta, double stress[6])
+{
+    double x[18], ue[18], u0[18], strain[6];
+    fs_wedge_element_coords(w, e, x);
+    gather_u(w, e, ue);
+    fs_wedge_shrink_displacement(w, x, u0);
+    for (int a = 0; a < 18; a++)
+        ue[a] -= u0[a];
+    if (fs_wedge_strain(x, ue, r, s, zeta, strain) < 0)
+        return -1;
+    stress_of(w, e, strain, stress);
+    return 0;
+}
+
+/* Strain (Voigt, engineering shears) of nodal displacements u from the shape-function gradients. */
+static void strain_from_gradients(const double dndx[18], const double u[18], double strain[6])
+{
+    double g[3][3] = {{0}};
+    for (int n = 0; n < 6; n++)
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                g[i][j] += dndx[3 * n + j] * u[3 * n + i];
+    strain[0] = g[0][0];
+    strain[1] = g[1][1];
+    strain[2] = g[2][2];
+    strain[3] = g[0][1] + g[1][0];
+    strain[4] = g[1][2] + g[2][1];
+    strain[5] = g[2][0] + g[0][2];
+}
+
+/* design: a bound of how fast an element's ratio can change with its nodal displacements u_e, for
+ * the lazy re-evaluation in element_ratios. The stress at a Gauss point is linear in u_e, sigma = E D B
+ * u_e + const, and the largest eigenvalue of a symmetric tensor moves by at most the spectral norm of
+ * the change (Weyl), which is at most its Frobenius norm, at most ||W D B||_F ||du_e|| (W weighs the
+ * Voigt shears by sqrt 2 to give the tensor norm). The largest over the three top Gauss points, times
+ * E over the threshold. */
+static double ratio_lipschitz(const fs_wedge_model *w, int32_t e, const double *cache)
+{
+    double worst = 0.0;
+    for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
+        double sum = 0.0;
+        for (int a = 0; a < 18; a++) {
+            double unit[18] = {0}, strain[6];
+            unit[a] = 1.0;
+            strain_from_gradients(cache + 18 * g, unit, strain);
+            for (int i = 0; i < 6; i++) {
+                double s = 0.0;
+                for (int j = 0; j < 6; j++)
+                    s += w->d_unit[6 * i + j] * strain[j];
+                sum += (i < 3 ? 1.0 : 2.0) * s * s;
+            }
+        }
+        worst = fmax(worst, sqrt(sum));
+    }
+    return worst * w->young[e] / w->threshold[e];
+}
+
+int fs_wedge_refresh_cache(fs_wedge_model *w, const int32_t *elems, int32_t n)
+{
+    for (int32_t q = 0; q < n; q++) {
+        int32_t e = elems ? elems[q] : q;
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        double x[18], pat[FS_WEDGE_PATTERNS][18], detj;
+        fs_wedge_element_coords(w, e, x);
+        fs_wedge_patterns(x, pat);
+        double *c = w->gauss_cache + FS_WEDGE_GAUSS_CACHE * (size_t)e;
+        for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
+            double *dndx = c + 18 * g;
+            if (fs_wedge_gradients(x, fs_wedge_gauss[g][0], fs_wedge_gauss[g][1], fs_wedge_gauss[g][2], dndx, &detj) < 0) {
+                fs_error(FS_ERR_DATA, "wedge model: element %d is inverted or degenerate (det J = %g)", (int)e, detj);
+                return -1;
+            }
+            for (int k = 0; k < 3; k++)
+                strain_from_gradients(dndx, pat[k], c + 54 + 18 * g + 6 * k);
+        }
+        w->ratio_lipschitz[e] = ratio_lipschitz(w, e, c);
+        w->ratio_ref_bound[e] = NAN;
+        for (int k = 0; k < 3; k++) {
+            double a[3], b[3], d[3];
+            fs_mesh_corner(w->mesh, e, k, a);
+            fs_mesh_corner(w->mesh, e, (k + 1) % 3, b);
+            fs_sub3(d, a, b);
+            w->edge_rest[3 * (size_t)e + k] = fs_norm3(d);
+        }
+    }
+    return 0;
+}
+
+/* Lazy ratio bounds (element_ratios) above this are evaluated in full: below 1 by more than the tie
+ * tolerance of fracture/rank.h, so a lazy bound never joins a tie with a maximum over 1. */
+#define LAZY_LEVEL (1.0 - 4.0 * FS_RANK_TIE_REL)
+
+/* Relative allowance for rounding in a lazy ratio bound. */
+#define LAZY_MARGIN 1e-9
+
+double fs_wedge_element_ratio(const fs_wedge_model *w, int32_t e)
+{
+    if (w->state[e] != FS_WEDGE_ALIVE)
+        return NAN;
+    double best = -INFINITY, sigma[3];
+    for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
+        if (fs_eigen_principal_stress(w->stress_top + 18 * (size_t)e + 6 * g, sigma, NULL) < 0)
+            return NAN;
+        best = fmax(best, sigma[0]);
+    }
+    return best / w->threshold[e];
+}
+
+typedef struct {
+    double bound;
+    int32_t e;
+} bound_entry;
+
+static int cmp_bound_desc(const void *a, const void *b)
+{
+    const bound_entry *x = a, *y = b;
+    if (x->bound != y->bound)
+        return x->bound < y->bound ? 1 : -1;
+    return (x->e > y->e) - (x->e < y->e);
+}
+
+/* design: thesis §5.6.1 evaluates the stress at the three Gauss points nearest the top face ("the
+ * resulting 9 values are sorted, and the largest one is compared against the material's threshold
+ * stress"). Every fracture decision asks only whether the largest ratio exceeds 1 and which element
+ * has it (fracture/rank.h, ties within FS_RANK_TIE_REL), so the shared eigen kernel runs only on the
+ * elements whose upper bound (fs_eigen_principal_bound) could reach the largest exact ratio, in
+ * descending order of the bound, until the next bound falls below the best exact ratio found (less
+ * the tie tolerance). Every other ratio holds its bound.
+ * With lazy_ratios, an element evaluated before at the same shrinkage and eigenstrain is not evaluated
+ * again while its old bound plus ratio_lipschitz times the change of its nodal displacements stays at
+ * most LAZY_LEVEL: that sum bounds the exact ratio too. After a removal the displacements change
+ * little away from the crack tip (within a few layer thicknesses), so most elements are skipped. Every
+ * element that could be over 1 or tie with a maximum over 1 still gets its full bound, so the
+ * candidates, the exact ratios and the decisions are the same as without. */
+/* The corners of element e need their nodal ratios recomputed. */
+static void touch_nodes(fs_wedge_model *w, int32_t e)
+{
+    for (int c = 0; c < 3; c++)
+        w->node_ratio[w->mesh->tri[3 * (size_t)e + c]] = NAN;
+}
+
+int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_elems)
+{
+    double t0 = fs_seconds();
+    int32_t n_over = 0;
+    double coef[FS_WEDGE_PATTERNS];
+    fs_wedge_load_coefficients(w, coef);
+    if (memcmp(coef, w->ratio_ref_coef, sizeof coef) != 0) {
+        for (int32_t e = 0; e < w->n_elems; e++)
+            w->ratio_ref_bound[e] = NAN;
+        memcpy(w->ratio_ref_coef, coef, sizeof coef);
+    }
+    for (int32_t q = 0; q < n_elems; q++) {
+        int32_t e = elems ? elems[q] : q;
+        if (w->state[e] != FS_WEDGE_ALIVE) {
+            w->ratio[e] = NAN;
+            touch_nodes(w, e);
+            continue;
+        }
+        double ue[18];
+        gather_u(w, e, ue);
+        double *ref_u = w->ratio_ref_u + 18 * (size_t)e;
+        if (w->lazy_ratios && !isnan(w->ratio_ref_bound[e])) {
+            double d2 = 0.0;
+            for (int a = 0; a < 18; a++)
+                d2 += (ue[a] - ref_u[a]) * (ue[a] - ref_u[a]);
+            double ref = w->ratio_ref_bound[e];
+            double lazy = ref + w->ratio_lipschitz[e] * sqrt(d2) + LAZY_MARGIN * fabs(ref);
+            if (lazy <= LAZY_LEVEL) {
+                w->ratio[e] = lazy;
+                continue;
+            }
+        }
+        const double *c = w->gauss_cache + FS_WEDGE_GAUSS_CACHE * (size_t)e;
+        double *st = w->stress_top + 18 * (size_t)e, bound = -INFINITY;
+        for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
+            double strain[6];
+            strain_from_gradients(c + 18 * g, ue, strain);
+            for (int k = 0; k < 3; k++)
+                for (int v = 0; v < 6; v++)
+                    strain[v] -= w->shrink_coef[k] * c[54 + 18 * g + 6 * k + v];
+            stress_of(w, e, strain, st + 6 * g);
+            bound = fmax(bound, fs_eigen_principal_bound(st + 6 * g, w->threshold[e]));
+        }
+        w->ratio[e] = bound / w->threshold[e];
+        w->ratio_ref_bound[e] = w->ratio[e];
+        touch_nodes(w, e);
+        memcpy(ref_u, ue, sizeof ue);
+    }
+    for (int32_t e = 0; e < w->n_elems; e++)
+        n_over += w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0;
+    if (n_over > 0) {
+        bound_entry *list = fs_malloc((size_t)n_over * sizeof *list);
+        int32_t n = 0;
+        for (int32_t e = 0; e < w->n_elems; e++)
+            if (w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0)
+                list[n++] = (bound_entry){w->ratio[e], e};
+        qsort(list, (size_t)n, sizeof *list, cmp_bound_desc);
+        double best = -INFINITY;
+        for (int32_t q = 0; q < n; q++) {
+            if (list[q].bound < best - 2.0 * FS_RANK_TIE_REL * fabs(best))
+                break;
+            double r = fs_wedge_element_ratio(w, list[q].e);
+            if (isnan(r)) {
+                free(list);
+                return -1;
+            }
+            w->ratio[list[q].e] = r;
+            best = fmax(best, r);
+        }
+        free(list);
+    }
+    w->counters.stress_seconds += fs_seconds() - t0;
+    return 0;
+}
+
+/* w->u from the free unknowns w->x and the fixed displacements w->u_fixed. */
+static void scatter_u(fs_wedge_model *w)
+{
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        for (int l = 0; l < 6; l++) {
+            int32_t g = w->dof[6 * (size_t)i + l];
+            w->u[6 * (size_t)i + l] = g < w->n_free ? w->x[g] : w->u_fixed[g - w->n_free];
+        }
+}
+
+int fs_wedge_equilibrium(fs_wedge_model *w, double t)
+{
+    w->residual_valid = false;
+    double h = fs_wedge_layer_thickness(w, t);
+    if (h != w->assembled_thickness && fs_wedge_refill_system(w, h) < 0)
+        return -1;
+    double scale[3];
+    fs_shrink_scales(&w->cfg.shrink, t, scale);
+    for (int k = 0; k < 3; k++)
+        w->shrink_coef[k] = scale[k] - 1.0;
+    w->eigenstrain[0] = w->eigenstrain[1] = w->eigenstrain[2] = 0.0;
+    if (w->growth_mode == FS_WEDGE_GROWTH_EIGENSTRAIN) {
+        double v[3];
+        fs_growth_strain(&w->growth, 0.0, t, NULL, v);
+        for (int k = 0; k < 3; k++)
+            w->eigenstrain[k] = -v[k];
+    }
+    fixed_displacements(w, t);
+    fs_wedge_build_rhs(w);
+    if ((w->factor_stale && w->cfg.solver.relax != FS_RELAX_LOCAL && fs_wedge_factorize(w, false) < 0) || solve(w) < 0)
+        return -1;
+    scatter_u(w);
+    w->time = t;
+    int rc = fs_wedge_element_ratios(w, NULL, w->n_elems);
+#ifdef FS_VALIDATE
+    if (rc == 0)
+        fs_wedge_check_state(w, "an equilibrium");
+#endif
+    return rc;
+}
+
+void fs_wedge_snapshot_take(const fs_wedge_model *w, fs_wedge_snapshot *s)
+{
+    s->time = w->time;
+    s->thickness = w->assembled_thickness;
+    memcpy(s->coef, w->shrink_coef, sizeof w->shrink_coef);
+    memcpy(s->coef + 3, w->eigenstrain, sizeof w->eigenstrain);
+    if (s->n_free != w->n_free || !s->x) {
+        free(s->x);
+        s->x = fs_malloc(((size_t)w->n_free + 1) * sizeof *s->x);
+    }
+    if (s->n_fixed != w->n_fixed || !s->u_fixed) {
+        free(s->u_fixed);
+        s->u_fixed = fs_malloc(((size_t)w->n_fixed + 1) * sizeof *s->u_fixed);
+    }
+    if (s->n_nodes != w->n_nodes || !s->node_ratio) {
+        free(s->node_ratio);
+        free(s->node_ratio_exact);
+        s->node_ratio = fs_malloc(((size_t)w->n_nodes + 1) * sizeof *s->node_ratio);
+        s->node_ratio_exact = fs_malloc((size_t)w->n_nodes + 1);
+    }
+    if (s->n_elems != w->n_elems || !s->stress_top) {
+        free(s->stress_top);
+        s->stress_top = fs_malloc((18 * (size_t)w->n_elems + 1) * sizeof *s->stress_top);
+    }
+    s->n_free = w->n_free;
+    s->n_fixed = w->n_fixed;
+    s->n_nodes = w->n_nodes;
+    s->n_elems = w->n_elems;
+    memcpy(s->x, w->x, (size_t)w->n_free * sizeof *s->x);
+    memcpy(s->u_fixed, w->u_fixed, (size_t)w->n_fixed * sizeof *s->u_fixed);
+    memcpy(s->node_ratio, w->node_ratio, (size_t)w->n_nodes * sizeof *s->node_ratio);
+    memcpy(s->node_ratio_exact, w->node_ratio_exact, (size_t)w->n_nodes);
+    memcpy(s->stress_top, w->stress_top, 18 * (size_t)w->n_elems * sizeof *s->stress_top);
+}
+
+void fs_wedge_snapshot_free(fs_wedge_snapshot *s)
+{
+    free(s->x);
+    free(s->u_fixed);
+    free(s->node_ratio);
+    free(s->node_ratio_exact);
+    free(s->stress_top);
+    memset(s, 0, sizeof *s);
+}
+
+int fs_wedge_interpolate(fs_wedge_model *w, const fs_wedge_snapshot *a, const fs_wedge_snapshot *b, double t)
+{
+    FS_ASSERT(a->n_free == w->n_free && b->n_free == w->n_free && a->n_fixed == w->n_fixed &&
+              b->n_fixed == w->n_fixed);
+    double span = b->time - a->time, s = span > 0.0 ? (t - a->time) / span : 1.0;
+    w->residual_valid = false;
+    for (int k = 0; k < 3; k++) {
+        w->shrink_coef[k] = a->coef[k] + s * (b->coef[k] - a->coef[k]);
+        w->eigenstrain[k] = a->coef[3 + k] + s * (b->coef[3 + k] - a->coef[3 + k]);
+    }
+    for (int32_t i = 0; i < w->n_free; i++)
+        w->x[i] = a->x[i] + s * (b->x[i] - a->x[i]);
+    for (int32_t j = 0; j < w->n_fixed; j++)
+        w->u_fixed[j] = a->u_fixed[j] + s * (b->u_fixed[j] - a->u_fixed[j]);
+    scatter_u(w);
+    w->time = t;
+    return fs_wedge_element_ratios(w, NULL, w->n_elems);
+}
+
+int fs_wedge_update_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n)
+{
+    return fs_wedge_element_ratios(w, elems, elems ? n : w->n_elems);
+}
+
+void fs_wedge_prescribe_fixed(fs_wedge_model *w)
+{
+    fixed_displacements(w, w->time);
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        for (int l = 0; l < 6; l++) {
+            int32_t g = w->dof[6 * (size_t)i + l];
+            if (g >= w->n_free)
+                w->u[6 * (size_t)i + l] = w->u_fixed[g - w->n_free];
+        }
+}
+
+double fs_wedge_max_ratio(const fs_wedge_model *w)
+{
+    double best = -INFINITY;
+    for (int32_t e = 0; e < w->n_elems; e++)
+        if (w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > best)
+            best = w->ratio[e];
+    return best;
+}
+
+int fs_wedge_nodal_stress(const fs_wedge_model *w, int32_t node, bool top, double stress[6])
+{
+    /* The Gauss point nearest corner c: (2/3, 1/6) for node 0 (r = 1), (1/6, 2/3) for node 1 (s = 1),
+     * (1/6, 1/6) for node 2; the top row of Table 5.1 for top nodes, the bottom row otherwise. */
+    fs_nodal_stress mean = {{0.0}, 0};
+    for (int32_t p = w->node_elem_start[node]; p < w->node_elem_start[node] + w->node_elem_count[node]; p++) {
+        int32_t e = w->node_elem[p];
+        if (w->state[e] != FS_WEDGE_ALIVE)
+            continue;
+        int c = 0;
+        while (c < 3 && w->mesh->tri[3 * (size_t)e + c] != node)
+            c++;
+        FS_ASSERT(c < 3);
+        const double *g = fs_wedge_gauss[(top ? 0 : 6) + c];
+        double s[6];
+        if (fs_wedge_element_stress(w, e, g[0], g[1], g[2], s) < 0)
+            return -1;
+        fs_nodal_stress_add(&mean, s);
+    }
+    fs_nodal_stress_mean(&mean, stress);
+    return mean.count;
+}
+
+
+double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e)
+{
+    if (w->state[e] != FS_WEDGE_ALIVE)
+        return 0.0;
+    double K[324], loads[FS_WEDGE_PATTERNS][18], x[18], pat[FS_WEDGE_PATTERNS][18], ue[18];
+    if (fs_wedge_element_system(w, e, w->assembled_thickness, K, loads) < 0) {
+        fs_error_clear();
+        return NAN;
+    }
+    fs_wedge_element_coords(w, e, x);
+    fs_wedge_patterns(x, pat);
+    gather_u(w, e, ue);
+    double coef[FS_WEDGE_PATTERNS];
+    fs_wedge_load_coefficients(w, coef);
+    for (int a = 0; a < 18; a++)
+        for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
+            ue[a] -= coef[q] * pat[q][a];
+    double energy = 0.0;
+    for (int a = 0; a < 18; a++) {
+        double f = 0.0;
+        for (int b = 0; b < 18; b++)
+            f += K[18 * a + b] * ue[b];
+        energy += f * ue[a];
+    }
+    return 0.5 * energy;
+}
