@@ -6,11 +6,9 @@
 
 #include "base/error.h"
 #include "base/log.h"
-#include "geom/domain.h"
 #include "image/image.h"
+#include "io/outputs.h"
 #include "io/preset.h"
-#include "render/crackgraph.h"
-#include "render/occlusion.h"
 #include "sim/sim.h"
 
 static int fail(void)
@@ -31,9 +29,6 @@ int main(int argc, char **argv)
     fs_result res;
     if (fs_sim_run(&cfg, &res) < 0)
         return fail();
-    fs_domain d = cfg.domain;
-    fs_domain_normalize(&d);
-    bool wu = fs_domain_wraps_u(&d), wv = fs_domain_wraps_v(&d);
     char tmp[] = "/tmp/fissure-bench-XXXXXX";
     if (!mkdtemp(tmp))
         return 1;
@@ -42,38 +37,24 @@ int main(int argc, char **argv)
     int n_sizes = argc > 2 ? argc - 2 : 4;
     for (int s = 0; s < n_sizes; s++) {
         int size = argc > 2 ? atoi(argv[2 + s]) : default_sizes[s];
-        fs_raster r;
-        double t0 = fs_seconds();
-        if (fs_render_raster(&res.surface, size, size, cfg.render.supersample, wu, wv, &r) < 0)
-            return fail();
-        double t1 = fs_seconds();
-        fs_crackgraph_params cp = fs_crackgraph_params_default();
-        fs_crackgraph g;
-        if (fs_crackgraph_build(&r, wu, wv, &cp, &g) < 0)
-            return fail();
-        double t2 = fs_seconds();
-        fs_occlusion_params op = fs_occlusion_params_default();
-        fs_image ao;
-        fs_occlusion_build(&r, &op, wu, wv, &ao);
-        double t3 = fs_seconds();
-        fs_maps maps;
-        if (fs_maps_build(&r, &cfg.render, wu, wv, 1.0, 1.0, &maps) < 0)
+        cfg.render.width = cfg.render.height = size;
+        bool kinds[FS_MAP_COUNT] = {[FS_MAP_OCCLUSION] = true, [FS_MAP_CRACKS] = true};
+        fs_outputs b;
+        if (fs_outputs_build(&res.surface, &cfg, kinds, false, &b) < 0)
             return fail();
         double t4 = fs_seconds();
-        if (fs_image_write_tagged(png, &maps.basecolor, FS_IMAGE_UNTAGGED) < 0)
+        if (fs_image_write_tagged(png, &b.maps.basecolor, FS_IMAGE_UNTAGGED) < 0)
             return fail();
         double t5 = fs_seconds();
-        if (fs_image_write_tagged(png, &maps.basecolor, FS_IMAGE_SRGB) < 0)
+        if (fs_image_write_tagged(png, &b.maps.basecolor, FS_IMAGE_SRGB) < 0)
             return fail();
         double t6 = fs_seconds();
-        printf("%s %dx%d: render %.3f s, crack graph %.3f s (%d cracks, %d nodes), occlusion %.3f s, "
+        printf("%s %dx%d: render %.3f s, maps %.3f s, crack graph %.3f s (%d cracks, %d nodes), occlusion %.3f s, "
                "basecolor png untagged %.3f s, srgb-tagged %.3f s\n",
-               preset, size, size, t1 - t0, t2 - t1, (int)g.n_edges, (int)g.n_nodes, t3 - t2, t5 - t4, t6 - t5);
+               preset, size, size, b.render_seconds, b.maps_seconds, b.cracks_seconds, (int)b.cracks.n_edges,
+               (int)b.cracks.n_nodes, b.occlusion_seconds, t5 - t4, t6 - t5);
         fflush(stdout);
-        fs_crackgraph_free(&g);
-        fs_image_free(&ao);
-        fs_maps_free(&maps);
-        fs_raster_free(&r);
+        fs_outputs_free(&b);
     }
     unlink(png);
     rmdir(tmp);

@@ -8,6 +8,7 @@
 #include "base/log.h"
 #include "geom/domain.h"
 #include "io/obj.h"
+#include "io/outputs.h"
 #include "io/preset.h"
 #include "render/render.h"
 #include "sim/sim.h"
@@ -38,13 +39,9 @@ int main(int argc, char **argv)
         return fail();
     fs_domain d = cfg.domain;
     fs_domain_normalize(&d);
-    bool wu = fs_domain_wraps_u(&d), wv = fs_domain_wraps_v(&d);
-    fs_raster raster;
-    fs_maps maps;
-    if (fs_render_raster(&res.surface, cfg.render.width, cfg.render.height, cfg.render.supersample, wu, wv,
-                         &raster) < 0 ||
-        fs_maps_build(&raster, &cfg.render, wu, wv, fs_domain_extent_x(&d) / cfg.render.width,
-                      fs_domain_extent_y(&d) / cfg.render.height, &maps) < 0)
+    bool kinds[FS_MAP_COUNT] = {[FS_MAP_PREVIEW] = true};
+    fs_outputs built;
+    if (fs_outputs_build(&res.surface, &cfg, kinds, false, &built) < 0)
         return fail();
 
     double t0 = fs_seconds();
@@ -60,19 +57,13 @@ int main(int argc, char **argv)
     if (fs_obj_write(obj, &l, "bench", NULL, NULL) < 0)
         return fail();
     double t2 = fs_seconds();
-    fs_image preview;
-    if (fs_render_preview(&res.surface, &d, &cfg.render, &maps, &preview) < 0)
-        return fail();
-    double t3 = fs_seconds();
     printf("preset=%s render_tris=%d lifted_tris=%d positions=%d lift_s=%.3f obj_s=%.3f preview=%dx%d preview_s=%.3f\n",
            preset, (int)res.surface.n_tris, (int)l.n_tris, (int)l.n_pos, t1 - t0, t2 - t1, cfg.render.preview_width,
-           cfg.render.preview_height, t3 - t2);
+           cfg.render.preview_height, built.preview_seconds);
     unlink(obj);
     rmdir(tmp);
-    fs_image_free(&preview);
     fs_lifted_mesh_free(&l);
-    fs_maps_free(&maps);
-    fs_raster_free(&raster);
+    fs_outputs_free(&built);
     fs_result_free(&res);
     return 0;
 }

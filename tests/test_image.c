@@ -295,10 +295,155 @@ static void test_srgb_tag(void)
     fs_image_free(&b);
 }
 
+typedef struct {
+    const char *what;
+    const unsigned char *bytes;
+    size_t n;
+    const char *format; /* NULL: unknown */
+    int64_t width, height; /* 0: no size */
+} probe_case;
+
+#define BYTES(...) (const unsigned char[]){__VA_ARGS__}, sizeof((const unsigned char[]){__VA_ARGS__})
+
+/* Headers give the format and the size without decoding, for every format fissure reads, and a
+ * truncated or unknown header gives none. */
+static void test_probe(void)
+{
+    static const char pnm[] = "P5\n# a comment\n640 480\n255\n";
+    static const char pam[] = "P7\nWIDTH 12\nHEIGHT 34\nDEPTH 1\nMAXVAL 255\nTUPLTYPE GRAYSCALE\nENDHDR\n";
+    static const char pfm[] = "Pf\n7 9\n-1.0\n";
+    const probe_case cases[] = {
+        {"PNG", BYTES(0x89, 'P', 'N', 'G', 13, 10, 26, 10, 0, 0, 0, 13, 'I', 'H', 'D', 'R', 0, 0, 0x75, 0x30, 0, 0,
+                      0x4e, 0x20, 8, 0, 0, 0, 0),
+         "PNG", 30000, 20000},
+        {"PNG cut in IHDR", BYTES(0x89, 'P', 'N', 'G', 13, 10, 26, 10, 0, 0, 0, 13, 'I', 'H', 'D', 'R', 0, 0),
+         "PNG", 0, 0},
+        {"JPEG after APP0", BYTES(0xff, 0xd8, 0xff, 0xe0, 0, 16, 'J', 'F', 'I', 'F', 0, 1, 1, 0, 0, 1, 0, 1, 0, 0,
+                                  0xff, 0xc2, 0, 17, 8, 0x01, 0xe0, 0x02, 0x80, 3),
+         "JPEG", 640, 480},
+        {"JPEG without a frame", BYTES(0xff, 0xd8, 0xff, 0xd9), "JPEG", 0, 0},
+        {"BMP, top-down", BYTES('B', 'M', 0, 0, 0, 0, 0, 0, 0, 0, 54, 0, 0, 0, 40, 0, 0, 0, 0x80, 2, 0, 0, 0x20, 0xfe,
+                                0xff, 0xff),
+         "BMP", 640, 480},
+        {"BMP, OS/2 core header", BYTES('B', 'M', 0, 0, 0, 0, 0, 0, 0, 0, 26, 0, 0, 0, 12, 0, 0, 0, 100, 0, 50, 0),
+         "BMP", 100, 50},
+        {"TIFF, little-endian", BYTES('I', 'I', 42, 0, 8, 0, 0, 0, 2, 0, 0, 1, 3, 0, 1, 0, 0, 0, 0x2c, 1, 0, 0, 1, 1,
+                                      4, 0, 1, 0, 0, 0, 200, 0, 0, 0),
+         "TIFF", 300, 200},
+        {"TIFF, big-endian", BYTES('M', 'M', 0, 42, 0, 0, 0, 8, 0, 2, 1, 0, 0, 4, 0, 0, 0, 1, 0, 0, 1, 0x2c, 1, 1, 0,
+                                   3, 0, 0, 0, 1, 0, 200, 0, 0),
+         "TIFF", 300, 200},
+        {"TIFF, IFD past the end", BYTES('I', 'I', 42, 0, 0xff, 0xff, 0, 0), "TIFF", 0, 0},
+        {"OpenEXR", BYTES(0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0, 'd', 'a', 't', 'a', 'W', 'i', 'n', 'd', 'o', 'w', 0, 'b',
+                          'o', 'x', '2', 'i', 0, 16, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 99, 0, 0, 0, 49, 0, 0, 0, 0),
+         "OpenEXR", 100, 50},
+        {"OpenEXR, attribute size past the end", BYTES(0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0, 'x', 0, 'y', 0, 0xff, 0xff,
+                                                       0xff, 0x7f),
+         "OpenEXR", 0, 0},
+        {"PGM", (const unsigned char *)pnm, sizeof pnm - 1, "PNM", 640, 480},
+        {"PAM", (const unsigned char *)pam, sizeof pam - 1, "PNM", 12, 34},
+        {"PFM", (const unsigned char *)pfm, sizeof pfm - 1, "PNM", 7, 9},
+        {"WebP, extended", BYTES('R', 'I', 'F', 'F', 30, 0, 0, 0, 'W', 'E', 'B', 'P', 'V', 'P', '8', 'X', 10, 0, 0, 0,
+                                 0, 0, 0, 0, 0x7f, 2, 0, 0xdf, 1, 0),
+         "WebP", 640, 480},
+        {"WebP, lossless", BYTES('R', 'I', 'F', 'F', 30, 0, 0, 0, 'W', 'E', 'B', 'P', 'V', 'P', '8', 'L', 10, 0, 0, 0,
+                                 0x2f, 0x7f, 0xc2, 0x77, 0),
+         "WebP", 640, 480},
+        {"GIF", BYTES('G', 'I', 'F', '8', '9', 'a', 1, 0, 1, 0), NULL, 0, 0},
+        {"empty", (const unsigned char *)"", 0, NULL, 0, 0},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const probe_case *c = &cases[i];
+        fs_image_header h;
+        int rc = fs_image_probe(c->bytes, c->n, &h);
+        CHECK_MSG(rc == (c->width > 0 ? 0 : -1), "%s: returned %d", c->what, rc);
+        CHECK_MSG(c->format ? h.format && !strcmp(h.format, c->format) : h.format == NULL, "%s: format %s", c->what,
+                  h.format ? h.format : "none");
+        CHECK_MSG(h.width == c->width && h.height == c->height, "%s: %lld x %lld", c->what, (long long)h.width,
+                  (long long)h.height);
+    }
+    /* files as the writers make them */
+    const char *written[] = {"g8.png", "rgb16.png", "g.exr"};
+    for (int k = 0; k < 3; k++) {
+        unsigned char head[4096];
+        FILE *f = fopen(tmp_path(written[k]), "rb");
+        size_t n = f ? fread(head, 1, sizeof head, f) : 0;
+        if (f)
+            fclose(f);
+        fs_image_header h;
+        CHECK_MSG(fs_image_probe(head, n, &h) == 0 && h.width == 37 && h.height == 23, "%s", written[k]);
+    }
+}
+
+/* A map larger than the limit is refused by its header's size before any decoding (a valid
+ * 30000 x 30000 grey PNG was decoded at 8 GB); the data after the header is not even looked at. */
+static void test_pixel_limits(void)
+{
+    unsigned char png[64] = {0x89, 'P', 'N', 'G', 13, 10, 26, 10, 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                             0,    0,   0x75, 0x30, 0, 0, 0x75, 0x30, 8, 0, 0, 0, 0};
+    int w = 0, h = 0;
+    float *g = NULL;
+    fs_error_clear();
+    CHECK(fs_image_decode_grey(png, sizeof png, "huge.png", &w, &h, &g) == -1 && g == NULL);
+    CHECK(fs_error_domain() == FS_ERR_DATA);
+    CHECK_MSG(!strcmp(fs_error_message(), "huge.png: PNG image of 30000 x 30000 pixels: expected at most 67108864 "
+                                          "pixels"),
+              "%s", fs_error_message());
+    /* 16385 x 16384: over what fs_image_read takes (the largest map fissure writes) */
+    png[18] = 0x40;
+    png[19] = 0x01;
+    png[22] = 0x40;
+    png[23] = 0x00;
+    FILE *f = fopen(tmp_path("wide.png"), "wb");
+    if (f) {
+        fwrite(png, 1, sizeof png, f);
+        fclose(f);
+    }
+    fs_image img = {0};
+    fs_error_clear();
+    CHECK(fs_image_read(tmp_path("wide.png"), &img) == -1 && fs_error_domain() == FS_ERR_DATA);
+    CHECK_MSG(strstr(fs_error_message(), "16385 x 16384 pixels: expected at most 268435456 pixels") != NULL, "%s",
+              fs_error_message());
+    /* an unknown format is named as such */
+    fs_error_clear();
+    CHECK(fs_image_decode_grey((const unsigned char *)"GIF89a", 6, "a.gif", &w, &h, &g) == -1);
+    CHECK_MSG(strstr(fs_error_message(), "a.gif: not an image fissure reads") != NULL, "%s", fs_error_message());
+}
+
+/* A decoder's complaint is part of fissure's message (it printed "libpng error: ..." on stderr
+ * ahead of it), and a good map decodes to its grey levels. */
+static void test_decoder_message(void)
+{
+    fs_image a;
+    fs_image_alloc(&a, 40, 30, 1, FS_PIX_U8);
+    for (size_t k = 0; k < fs_image_bytes(&a); k++)
+        ((uint8_t *)a.data)[k] = (uint8_t)(k % 7 * 40);
+    CHECK(fs_image_write(tmp_path("grey.png"), &a) == 0);
+    unsigned char buf[8192];
+    FILE *f = fopen(tmp_path("grey.png"), "rb");
+    size_t n = f ? fread(buf, 1, sizeof buf, f) : 0;
+    if (f)
+        fclose(f);
+    int w = 0, h = 0;
+    float *g = NULL;
+    CHECK(fs_image_decode_grey(buf, n, "grey.png", &w, &h, &g) == 0 && w == 40 && h == 30);
+    if (g)
+        CHECK_NEAR(g[3], 120.0 / 255.0, 1e-6);
+    free(g);
+    g = NULL;
+    buf[n - 20] ^= 0xff; /* inside the IDAT data, before the CRC */
+    buf[n - 21] ^= 0xff;
+    fs_error_clear();
+    CHECK(fs_image_decode_grey(buf, n, "grey.png", &w, &h, &g) == -1 && fs_error_domain() == FS_ERR_DATA);
+    CHECK_MSG(strstr(fs_error_message(), "grey.png: cannot decode the PNG image: libpng error: ") != NULL, "%s",
+              fs_error_message());
+    fs_image_free(&a);
+}
+
 static void remove_tmpdir(void)
 {
     const char *names[] = {"g8.png", "rgb8.png", "g16.png", "rgb16.png", "g.exr", "rgb.exr", "red.png", "junk.png",
-                           "tagged.png", "plain.png"};
+                           "tagged.png", "plain.png", "wide.png", "grey.png"};
     for (size_t k = 0; k < sizeof names / sizeof *names; k++)
         unlink(tmp_path(names[k]));
     rmdir(tmpdir);
@@ -323,6 +468,9 @@ int main(void)
     RUN(test_read_errors);
     RUN(test_write_error);
     RUN(test_srgb_tag);
+    RUN(test_probe);
+    RUN(test_pixel_limits);
+    RUN(test_decoder_message);
     remove_tmpdir();
     return check_finish();
 }

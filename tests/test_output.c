@@ -2,10 +2,12 @@
 #include "io/output.h"
 
 #include <dirent.h>
+#include <signal.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "base/error.h"
@@ -226,6 +228,150 @@ static void test_unwritable(void)
     }
 }
 
+/* The sidecar (the seal) is moved last, and an old sidecar of the same name goes before any file
+ * of the new set replaces one it lists; the set lists its files but the sidecar. */
+static void test_seal(void)
+{
+    char dir[256], old_json[512], old_map[512], other[512];
+    snprintf(dir, sizeof dir, "%s/seal", tmpdir);
+    fs_output *o = fs_output_begin(dir);
+    CHECK(o != NULL);
+    if (!o)
+        return;
+    write_text(fs_output_stage(o, "n_height.png"), "old height");
+    write_text(fs_output_stage(o, "n_normal.png"), "old normal");
+    write_text(fs_output_stage_seal(o, "n.json"), "old sidecar");
+    snprintf(old_json, sizeof old_json, "%s", fs_output_final_path(o, "n.json"));
+    snprintf(old_map, sizeof old_map, "%s", fs_output_final_path(o, "n_normal.png"));
+    CHECK(fs_output_commit(o) == 0);
+
+    /* a second set of the same name whose commit fails half-way: one file was never written */
+    o = fs_output_begin(dir);
+    CHECK(o != NULL);
+    if (!o)
+        return;
+    write_text(fs_output_stage(o, "n_height.png"), "new height");
+    fs_output_stage(o, "n_normal.png");
+    write_text(fs_output_stage_seal(o, "n.json"), "new sidecar");
+    int n = 0;
+    const char **names = fs_output_names(o, &n);
+    CHECK(n == 2 && !strcmp(names[0], "n_height.png") && !strcmp(names[1], "n_normal.png"));
+    free(names);
+    fs_error_clear();
+    CHECK(fs_output_commit(o) == -1);
+    CHECK(fs_error_domain() == FS_ERR_IO);
+    /* neither sidecar is left beside the files: the old one went first, the new one never came; the
+     * new height that was already moved into place is removed again */
+    CHECK(!exists(old_json));
+    snprintf(other, sizeof other, "%s/n_height.png", dir);
+    CHECK(!exists(other));
+    const char *text = read_text(old_map);
+    CHECK(text && !strcmp(text, "old normal"));
+    CHECK(count_entries(dir) == 1);
+
+    /* a whole set: the sidecar and its files, nothing else */
+    o = fs_output_begin(dir);
+    CHECK(o != NULL);
+    if (!o)
+        return;
+    write_text(fs_output_stage(o, "n_height.png"), "third height");
+    write_text(fs_output_stage_seal(o, "n.json"), "third sidecar");
+    CHECK(fs_output_commit(o) == 0);
+    text = read_text(old_json);
+    CHECK(text && !strcmp(text, "third sidecar"));
+    CHECK(count_entries(dir) == 3);
+}
+
+/* Files staged in another directory join a set and are committed with it, listed by absolute path;
+ * files staged in the same directory keep their names. */
+static void test_merge(void)
+{
+    char dir[256], elsewhere[256], same[256];
+    snprintf(dir, sizeof dir, "%s/merge", tmpdir);
+    snprintf(elsewhere, sizeof elsewhere, "%s/merge-mesh", tmpdir);
+    snprintf(same, sizeof same, "%s/merge/.", tmpdir);
+    fs_output *o = fs_output_begin(dir), *m = fs_output_begin(elsewhere), *f = fs_output_begin(same);
+    CHECK(o && m && f);
+    if (!o || !m || !f)
+        return;
+    write_text(fs_output_stage(o, "a.png"), "a");
+    write_text(fs_output_stage(f, "a_frame_0001.png"), "frame");
+    write_text(fs_output_stage(m, "a.obj"), "mesh");
+    fs_output_merge(o, f);
+    fs_output_merge(o, m);
+    write_text(fs_output_stage_seal(o, "a.json"), "sidecar");
+    int n = 0;
+    const char **names = fs_output_names(o, &n);
+    char want[512];
+    snprintf(want, sizeof want, "%s/a.obj", elsewhere);
+    CHECK(n == 3 && !strcmp(names[0], "a.png") && !strcmp(names[1], "a_frame_0001.png"));
+    CHECK_MSG(n == 3 && !strcmp(names[2], want), "%s", n == 3 ? names[2] : "");
+    free(names);
+    CHECK(count_entries(elsewhere) == 1 && count_entries(dir) == 3);
+    CHECK(fs_output_commit(o) == 0);
+    CHECK(exists(want));
+    CHECK(count_entries(elsewhere) == 1 && count_entries(dir) == 3);
+}
+
+/* fs_output_check creates nothing, accepts a directory still to be made below a writable one, and
+ * refuses a path through a regular file or a name too long for a path. */
+static void test_check(void)
+{
+    char dir[512], file[256];
+    snprintf(dir, sizeof dir, "%s/check/a/b", tmpdir);
+    CHECK(fs_output_check(dir, 40) == 0);
+    snprintf(dir, sizeof dir, "%s/check", tmpdir);
+    CHECK(!exists(dir));
+    snprintf(file, sizeof file, "%s/check-file", tmpdir);
+    write_text(file, "x");
+    fs_error_clear();
+    CHECK(fs_output_check(file, 40) == -1);
+    CHECK(fs_error_domain() == FS_ERR_CANTCREAT);
+    CHECK_MSG(strstr(fs_error_message(), "not a directory") != NULL, "%s", fs_error_message());
+    snprintf(dir, sizeof dir, "%s/below/c", file);
+    fs_error_clear();
+    CHECK(fs_output_check(dir, 40) == -1);
+    CHECK(fs_error_domain() == FS_ERR_CANTCREAT);
+    fs_error_clear();
+    CHECK(fs_output_check(tmpdir, 5000) == -1);
+    CHECK(fs_error_domain() == FS_ERR_CANTCREAT);
+    CHECK(fs_output_check(".", 40) == 0);
+}
+
+/* A termination signal removes the staged files of every uncommitted set, leaves committed files,
+ * and ends the process by that signal (blocked in the main thread: the cleanup thread takes it). */
+static void test_signal_cleanup(void)
+{
+    char dir[256];
+    snprintf(dir, sizeof dir, "%s/signal", tmpdir);
+    pid_t pid = fork();
+    if (pid == 0) {
+        if (fs_output_cleanup_on_signals() != 0)
+            _exit(2);
+        fs_output *done = fs_output_begin(dir);
+        write_text(fs_output_stage(done, "kept.png"), "kept");
+        if (fs_output_commit(done) != 0)
+            _exit(3);
+        fs_output *a = fs_output_begin(dir), *b = fs_output_begin(dir);
+        for (int i = 0; i < 100; i++) {
+            char name[32];
+            snprintf(name, sizeof name, "f%03d.png", i);
+            write_text(fs_output_stage(i % 2 ? a : b, name), "x");
+        }
+        fs_output_stage(a, "never-written.png");
+        kill(getpid(), SIGTERM);
+        for (;;)
+            pause();
+    }
+    int status = 0;
+    CHECK(pid > 0 && waitpid(pid, &status, 0) == pid);
+    CHECK_MSG(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM, "status %d", status);
+    CHECK_MSG(count_entries(dir) == 1, "%d files left", count_entries(dir));
+    char kept[512];
+    snprintf(kept, sizeof kept, "%s/kept.png", dir);
+    CHECK(exists(kept));
+}
+
 int main(void)
 {
     if (!mkdtemp(tmpdir)) {
@@ -238,6 +384,10 @@ int main(void)
     RUN(test_commit_missing);
     RUN(test_subdirectory);
     RUN(test_unwritable);
+    RUN(test_seal);
+    RUN(test_merge);
+    RUN(test_check);
+    RUN(test_signal_cleanup);
     remove_tree(tmpdir);
     return check_finish();
 }

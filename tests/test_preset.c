@@ -638,6 +638,93 @@ static void test_preset_path(void)
     unsetenv("FISSURE_PRESET_PATH");
 }
 
+/* Numbers are decimal: hexadecimal floats and integers, which strtod reads, are refused. */
+static void test_decimal_only(void)
+{
+    static const char *const bad[] = {"0x10", "0x1p3", "0X1P-2", "-0x8", "1e", ".", "+.", "e5", "1.5.2", "infinity"};
+    static const char *const good[] = {"16", "8.", ".5", "+2", "-3e+2", "1E-3", "0.25e1"};
+    char assignment[64];
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        fs_config c = fs_config_default();
+        snprintf(assignment, sizeof assignment, "voronoi.warp_scale=%s", bad[i]);
+        fs_error_clear();
+        CHECK_MSG(fs_preset_set(&c, assignment) == -1 && fs_error_domain() == FS_ERR_DATA, "%s accepted", bad[i]);
+    }
+    for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) {
+        fs_config c = fs_config_default();
+        snprintf(assignment, sizeof assignment, "growth.rate=%s", good[i]);
+        CHECK_MSG(fs_preset_set(&c, assignment) == 0, "%s: %s", good[i], fs_error_message());
+        CHECK_NEAR(c.growth.rate, strtod(good[i], NULL), 0.0);
+    }
+    fs_config c = fs_config_default();
+    CHECK(fs_preset_load_string("[mesh]\nelements = 0x10\n", "t.ini", &c) == -1);
+    CHECK(fs_preset_load_string("[shrink]\ntop = 0:0, 0x1p0:0.1\n", "t.ini", &c) == -1);
+}
+
+/* Every text and path value the parser accepts survives the dump: a value starting with ';' would
+ * come back as a comment after the dump's "key = ", so it is refused; '#' is kept. */
+static void test_text_round_trip(void)
+{
+    fs_config c = fs_config_default();
+    fs_error_clear();
+    CHECK(fs_preset_load_string("[preset]\ndescription =;x\n", "t.ini", &c) == -1);
+    CHECK_MSG(strstr(fs_error_message(), "t.ini:2: [preset] description: expected one line without control "
+                                         "characters, a leading ';' or ' ;' (a comment), got ';x'") != NULL,
+              "%s", fs_error_message());
+    CHECK(fs_preset_set(&c, "material.young_map=;y.png") == -1);
+    CHECK(fs_preset_load_string("[preset]\ndescription =#x; y;z\n[material]\nyoung_map = #y.png\n", "t.ini",
+                                &c) == 0);
+    char *text = dump_string(&c);
+    fs_config d = fs_config_default();
+    CHECK(fs_preset_load_string(text, "dump", &d) == 0);
+    CHECK(!strcmp(d.preset.description, "#x; y;z") && !strcmp(d.material_files.young_map, "#y.png"));
+    char *again = dump_string(&d);
+    CHECK(!strcmp(text, again));
+    free(text);
+    free(again);
+}
+
+/* Presets are at most 1 MiB: a larger file is bad data, refused without reading it all, and a line
+ * with a NUL byte is a syntax error. (A FIFO and a device, which used to block or never end, are
+ * tried in tests/cli_hostile.sh under a timeout.) */
+static void test_file_limits(void)
+{
+    char dir[] = "/tmp/fissure-test-preset-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char big[160], nul[160];
+    snprintf(big, sizeof big, "%s/big.ini", dir);
+    snprintf(nul, sizeof nul, "%s/nul.ini", dir);
+    fs_config c = fs_config_default();
+    /* a comment line of 1 MiB + 1 byte: over the cap by its size */
+    FILE *f = fopen(big, "w");
+    CHECK(f != NULL);
+    if (f) {
+        fputc('#', f);
+        for (int i = 0; i < 1024 * 1024; i++)
+            fputc('a', f);
+        fclose(f);
+    }
+    fs_error_clear();
+    CHECK(fs_preset_load(big, &c) == -1 && fs_error_domain() == FS_ERR_DATA);
+    CHECK_MSG(strstr(fs_error_message(), "expected at most 1048576 bytes (1 MiB)") != NULL, "%s", fs_error_message());
+    CHECK(fs_preset_read_text(big) == NULL);
+    f = fopen(nul, "w");
+    if (f) {
+        static const char text[] = "[preset]\nname = a\nseed = 5\0001\n";
+        fwrite(text, 1, sizeof text - 1, f);
+        fclose(f);
+    }
+    fs_error_clear();
+    CHECK(fs_preset_load(nul, &c) == -1 && fs_error_domain() == FS_ERR_DATA);
+    CHECK_MSG(strstr(fs_error_message(), "nul.ini:3: syntax error") != NULL, "%s", fs_error_message());
+    char *text = fs_preset_read_text(nul);
+    CHECK(text && !strncmp(text, "[preset]", 8));
+    free(text);
+    unlink(big);
+    unlink(nul);
+    rmdir(dir);
+}
+
 int main(void)
 {
     RUN(test_defaults);
@@ -650,5 +737,8 @@ int main(void)
     RUN(test_color_round_trip);
     RUN(test_file_load);
     RUN(test_preset_path);
+    RUN(test_decimal_only);
+    RUN(test_text_round_trip);
+    RUN(test_file_limits);
     return check_finish();
 }

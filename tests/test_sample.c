@@ -423,6 +423,31 @@ static void test_errors(void)
     CHECK_MSG(strstr(fs_error_message(), "width") != NULL, "%s", fs_error_message());
 }
 
+/* Domains far smaller or thinner than their point spacing once asked for a grid of a million cells a
+ * side (a sphere of radius 1e-300: 10^12 columns, an abort on a 20 TB allocation); the grid keeps a
+ * few cells per point, and the points still lie in the domain. */
+static void test_degenerate_domains_bounded(void)
+{
+    fs_domain d[3] = {make_domain(FS_DOMAIN_SPHERE, 0, 0, 1e-300, false, false),
+                      make_domain(FS_DOMAIN_PLANE, 1e6, 1e-10, 0, true, true),
+                      make_domain(FS_DOMAIN_PLANE, 1e-300, 10, 0, false, false)};
+    for (int k = 0; k < 3; k++) {
+        fs_points pts = {0};
+        fs_sample_params sp = params(300, 2);
+        fs_error_clear();
+        int rc = fs_sample_repulsion(&d[k], &sp, &pts);
+        CHECK_MSG(rc == 0 || fs_error_domain() == FS_ERR_DATA, "domain %d: %s", k, fs_error_message());
+        for (int32_t i = 0; rc == 0 && i < pts.n; i++) {
+            const double *p = pts.p + 3 * (size_t)i;
+            if (d[k].type == FS_DOMAIN_PLANE)
+                CHECK(p[0] >= 0.0 && p[0] <= d[k].width && p[1] >= 0.0 && p[1] <= d[k].height);
+            else
+                CHECK(fabs(p[0]) <= 1e-300 && fabs(p[1]) <= 1e-300 && fabs(p[2]) <= 1e-300);
+        }
+        fs_points_free(&pts);
+    }
+}
+
 int main(void)
 {
     RUN(test_defaults);
@@ -434,5 +459,6 @@ int main(void)
     RUN(test_hex_plane);
     RUN(test_hex_periodic);
     RUN(test_errors);
+    RUN(test_degenerate_domains_bounded);
     return check_finish();
 }

@@ -1,4 +1,5 @@
 /* Tests of the sparse solvers: assembly, products, CHOLMOD Cholesky (factor, refactor, update) and CG. */
+#include <dlfcn.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -984,6 +985,48 @@ static void test_cg_principal_blocks(void)
     free(x_sub);
 }
 
+/* The factor and the solution do not depend on the BLAS's thread count: OpenBLAS's threaded
+ * dpotrf, dgemm and dtrsm round otherwise than its one-thread ones on supernodes of this size, so
+ * the solver puts it on one thread whatever it was set to (issue 16: -j changed the fractures). */
+static void test_cholesky_independent_of_blas_threads(void)
+{
+    void (*set_threads)(int) = NULL;
+    *(void **)(&set_threads) = dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
+    if (!set_threads) {
+        printf("skip: the BLAS is not OpenBLAS\n");
+        return;
+    }
+    enum { n = 600 };
+    fs_sparse_builder bld;
+    fs_sparse_builder_init(&bld, n, 0);
+    for (int32_t i = 0; i < n; i++)
+        for (int32_t j = i; j < n; j++)
+            fs_sparse_builder_add(&bld, i, j, (i == j ? n : 0.0) + fs_rand_range(7, FS_RNG_TEST, (uint64_t)(i * n + j), -1, 1));
+    fs_sparse_matrix a;
+    CHECK(fs_sparse_builder_compress(&bld, &a, NULL) == 0);
+    fs_sparse_builder_free(&bld);
+    double *b = random_vector(n, 11);
+    double *x[3];
+    const int threads[3] = {1, 4, 2};
+    for (int k = 0; k < 3; k++) {
+        x[k] = malloc((size_t)n * sizeof *x[k]);
+        set_threads(threads[k]);
+        fs_cholesky *c = fs_cholesky_analyze(&a);
+        CHECK(c != NULL);
+        set_threads(threads[k]);
+        CHECK(c && fs_cholesky_factorize(c, &a) == 0);
+        CHECK(c && fs_cholesky_solve(c, 1, b, x[k]) == 0);
+        fs_cholesky_free(c);
+    }
+    CHECK_MSG(relative_residual(&a, x[0], b) <= 1e-12, "residual %g", relative_residual(&a, x[0], b));
+    CHECK_MSG(memcmp(x[0], x[1], (size_t)n * sizeof *x[0]) == 0, "BLAS on 4 threads: another solution");
+    CHECK_MSG(memcmp(x[0], x[2], (size_t)n * sizeof *x[0]) == 0, "BLAS on 2 threads: another solution");
+    for (int k = 0; k < 3; k++)
+        free(x[k]);
+    free(b);
+    fs_sparse_matrix_free(&a);
+}
+
 int main(void)
 {
     RUN(test_builder_sums_duplicates);
@@ -1004,5 +1047,6 @@ int main(void)
     RUN(test_pcg_operator_matches_matrix_cg);
     RUN(test_pcg_small_cases);
     RUN(test_cg_dot_orders);
+    RUN(test_cholesky_independent_of_blas_threads);
     return check_finish();
 }

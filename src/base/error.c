@@ -1,6 +1,7 @@
 /* Error reporting and checked allocation. */
 #include "base/error.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <string.h>
@@ -15,6 +16,18 @@ void fs_error(fs_errdomain domain, const char *fmt, ...)
     vsnprintf(error_message, sizeof error_message, fmt, ap);
     va_end(ap);
     error_domain = domain;
+}
+
+int fs_close_written(FILE *f, const char *path, const char *what)
+{
+    /* a failed buffered write leaves its errno; the close's flush sets it again if it fails */
+    int err = ferror(f) ? (errno ? errno : EIO) : 0;
+    if (fclose(f) != 0 && !err)
+        err = errno ? errno : EIO;
+    if (!err)
+        return 0;
+    fs_error(FS_ERR_IO, "%s: cannot write %s: %s", path, what, strerror(err));
+    return -1;
 }
 
 const char *fs_error_message(void) { return error_message; }

@@ -21,6 +21,11 @@ typedef enum {
  * call this and return -1 (or NULL); the caller either handles it or passes the failure up. */
 void fs_error(fs_errdomain domain, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
+/* Closes a stream that was written to path. When a write or the close failed, records
+ * fs_error(FS_ERR_IO, "PATH: cannot write WHAT: REASON") with the system's reason (No space left on
+ * device, ...) and returns -1; else returns 0. */
+int fs_close_written(FILE *f, const char *path, const char *what);
+
 /* The pending message ("" if none) and its domain (FS_OK if none). */
 const char *fs_error_message(void);
 fs_errdomain fs_error_domain(void);

@@ -14,23 +14,10 @@
 #include "cli/cli.h"
 #include "cli/jobs.h"
 #include "config.h"
-#include "io/asset.h"
 #include "io/output.h"
+#include "io/outputs.h"
 #include "io/preset.h"
-#include "io/sidecar.h"
-#include "io/target.h"
-#include "render/crackgraph.h"
-#include "render/occlusion.h"
-#include "render/render.h"
 #include "sim/sim.h"
-
-enum {
-    MAP_HEIGHT, MAP_NORMAL, MAP_BASECOLOR, MAP_CRACKMASK, MAP_CRACKDIST, MAP_CELLID, MAP_PREVIEW, MAP_OCCLUSION,
-    MAP_CRACKS, MAP_COUNT
-};
-/* Map kinds; io/target.h names, packs and tags their files per engine. */
-static const char *const map_names[MAP_COUNT] = {"height", "normal", "basecolor", "crackmask", "crackdist", "cellid",
-                                                 "preview", "occlusion", "cracks"};
 
 typedef struct {
     const char *output_dir;
@@ -41,7 +28,7 @@ typedef struct {
     int width, height;
     char **sets;
     int n_sets;
-    bool maps[MAP_COUNT];
+    bool maps[FS_MAP_COUNT];
     bool exr;
     bool have_normal;
     fs_normal_convention normal;
@@ -63,6 +50,13 @@ enum {
 
 /* Most time-lapse frames one run writes. */
 #define MAX_FRAMES 10000
+
+/* Longest -n/--name in bytes: with the longest suffix fissure adds (a frame's
+ * "_frame_NNNN_crackmask.png", a glTF "_occlusionRoughnessMetallic.png", "T_" before an Unreal map)
+ * and the staging name's ".", ".tmp-PID-N", every file name stays under NAME_MAX (255). */
+#define MAX_NAME_BYTES 128
+/* Longest file name a run stages for a NAME of n bytes, as fs_output_check wants it. */
+#define STAGED_NAME_BYTES(n) ((n) + 2 + 31 + 1 + 5 + 20 + 1 + 20)
 
 static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},
@@ -143,6 +137,37 @@ static void print_help(FILE *out)
           out);
 }
 
+/* Whether s is UTF-8 (shortest forms, no surrogates, at most U+10FFFF). */
+static bool utf8_valid(const char *s)
+{
+    const unsigned char *p = (const unsigned char *)s;
+    while (*p) {
+        unsigned c = *p;
+        int more = c < 0x80 ? 0 : (c & 0xe0) == 0xc0 ? 1 : (c & 0xf0) == 0xe0 ? 2 : (c & 0xf8) == 0xf0 ? 3 : -1;
+        if (more < 0 || (more == 1 && c < 0xc2))
+            return false;
+        unsigned cp = more == 0 ? c : c & (0x3fu >> more);
+        for (int k = 1; k <= more; k++) {
+            if ((p[k] & 0xc0) != 0x80)
+                return false;
+            cp = (cp << 6) | (p[k] & 0x3fu);
+        }
+        if ((more == 2 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) || (more == 3 && (cp < 0x10000 || cp > 0x10ffff)))
+            return false;
+        p += more + 1;
+    }
+    return true;
+}
+
+/* Whether s has a control character (a newline would break "one path a line" on stdout). */
+static bool has_control(const char *s)
+{
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++)
+        if (*p < 0x20 || *p == 0x7f)
+            return true;
+    return false;
+}
+
 static int usage_error(const char *fmt, const char *arg)
 {
     fputs("fissure: ", stderr);
@@ -170,18 +195,18 @@ static bool parse_size(const char *s, int *w, int *h)
 
 static bool parse_maps(const char *list, bool *maps)
 {
-    memset(maps, 0, MAP_COUNT * sizeof *maps);
+    memset(maps, 0, FS_MAP_COUNT * sizeof *maps);
     char *copy = fs_strdup(list), *save = NULL;
     bool ok = true, any = false;
     for (char *tok = strtok_r(copy, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         bool found = false;
         if (!strcmp(tok, "all")) {
-            for (int i = 0; i < MAP_COUNT; i++)
+            for (int i = 0; i < FS_MAP_COUNT; i++)
                 maps[i] = true;
             found = true;
         }
-        for (int i = 0; i < MAP_COUNT && !found; i++)
-            if (!strcmp(tok, map_names[i]))
+        for (int i = 0; i < FS_MAP_COUNT && !found; i++)
+            if (!strcmp(tok, fs_map_name(i)))
                 maps[i] = found = true;
         ok = ok && found;
         any = any || found;
@@ -195,10 +220,18 @@ static int parse_options(int argc, char **argv, options *o)
     int c;
     while ((c = getopt_long(argc, argv, "o:n:s:j:qvhV", long_options, NULL)) != -1) {
         switch (c) {
-        case 'o': o->output_dir = optarg; break;
+        case 'o':
+            if (has_control(optarg))
+                return usage_error("--output: expected a directory name without control characters, got '%s'",
+                                   optarg);
+            o->output_dir = optarg;
+            break;
         case 'n':
-            if (!*optarg || strchr(optarg, '/'))
-                return usage_error("--name: expected a file name prefix without '/', got '%s'", optarg);
+            if (!*optarg || strchr(optarg, '/') || has_control(optarg) || !utf8_valid(optarg) ||
+                strlen(optarg) > MAX_NAME_BYTES)
+                return usage_error("--name: expected a file name prefix of 1 to 128 bytes of UTF-8 without '/' or "
+                                   "control characters, got '%s'",
+                                   optarg);
             o->name = optarg;
             break;
         case 's': {
@@ -289,8 +322,8 @@ static int parse_options(int argc, char **argv, options *o)
         case OPT_LIST: o->list_presets = true; break;
         case OPT_DUMP: o->dump_preset = true; break;
         case OPT_MESH:
-            if (!*optarg || optarg[strlen(optarg) - 1] == '/')
-                return usage_error("--mesh: expected a file name, got '%s'", optarg);
+            if (!*optarg || optarg[strlen(optarg) - 1] == '/' || has_control(optarg))
+                return usage_error("--mesh: expected a file name without control characters, got '%s'", optarg);
             o->mesh_path = optarg;
             break;
         case 'h': print_help(stdout); return -1;
@@ -321,25 +354,6 @@ static int fail(void)
     return status == FS_OK ? FS_ERR_INTERNAL : status;
 }
 
-/* Reads a whole (small) text file for hashing; NULL if unreadable. */
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 4096, n = 0;
-    char *buf = fs_malloc(cap);
-    size_t got;
-    while ((got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
-        n += got;
-        if (cap - n < 2)
-            buf = fs_realloc(buf, cap *= 2);
-    }
-    fclose(f);
-    buf[n] = '\0';
-    return buf;
-}
-
 /* Loads the preset and applies every override, in the order: file, --set, then dedicated options. */
 static int load_config(const char *arg, const options *o, fs_config *cfg, char **preset_path)
 {
@@ -363,11 +377,39 @@ static int load_config(const char *arg, const options *o, fs_config *cfg, char *
     return fs_preset_validate(cfg, *preset_path);
 }
 
-/* Map kinds a time-lapse frame can have: the texture-space rasters. */
-static bool frame_kind(int kind)
+/* The directory of a file path (malloc'd: "." for a bare name, "/" at the root), and in *file the
+ * file name in it. */
+static char *dir_of(const char *path, const char **file)
 {
-    return kind == MAP_HEIGHT || kind == MAP_NORMAL || kind == MAP_BASECOLOR || kind == MAP_CRACKMASK ||
-           kind == MAP_CRACKDIST || kind == MAP_CELLID;
+    char *dir = fs_strdup(path);
+    char *slash = strrchr(dir, '/');
+    *file = slash ? path + (slash - dir) + 1 : path;
+    if (!slash)
+        strcpy(dir, ".");
+    else
+        slash[slash == dir ? 1 : 0] = '\0';
+    return dir;
+}
+
+/* Checks, before the run, that the outputs can be created: the output directory (or the ancestor
+ * it would be created in) and the directories of the --mesh and --asset files are writable
+ * directories. */
+static int check_outputs(const options *o, const char *name)
+{
+    if (fs_output_check(o->output_dir, STAGED_NAME_BYTES(strlen(name))) < 0)
+        return -1;
+    const char *beside[2] = {o->mesh_path, o->asset_path};
+    for (int i = 0; i < 2; i++) {
+        if (!beside[i])
+            continue;
+        const char *file;
+        char *dir = dir_of(beside[i], &file);
+        int rc = fs_output_check(dir, STAGED_NAME_BYTES(strlen(file)));
+        free(dir);
+        if (rc < 0)
+            return -1;
+    }
+    return 0;
 }
 
 /* The time-lapse frames of one run: each frame is rendered and staged as it comes, in an output set
@@ -377,15 +419,15 @@ typedef struct {
     const fs_config *cfg;
     const char *name;
     fs_output *out;                    /* the staged frame files; NULL until the first frame */
-    const char *kinds[MAP_COUNT];      /* the maps of every frame */
+    const char *kinds[FS_MAP_COUNT];      /* the maps of every frame */
     int n_kinds;
     double *time, *height_min, *height_max; /* per frame */
     int64_t *fractures;
     char (*file)[512];                 /* every frame file, frame by frame */
     int n_files;
-    fs_sidecar_map map[MAP_COUNT];     /* per kind, from the first frame: what the sidecar says */
-    fs_image header[MAP_COUNT];        /* their sizes and types (no pixels) */
-    char pattern[MAP_COUNT][600];      /* their file name patterns */
+    fs_sidecar_map map[FS_MAP_COUNT];     /* per kind, from the first frame: what the sidecar says */
+    fs_image header[FS_MAP_COUNT];        /* their sizes and types (no pixels) */
+    char pattern[FS_MAP_COUNT][600];      /* their file name patterns */
 } frame_writer;
 
 static void frame_writer_init(frame_writer *fw, const options *o, const fs_config *cfg, const char *name)
@@ -394,12 +436,12 @@ static void frame_writer_init(frame_writer *fw, const options *o, const fs_confi
     fw->o = o;
     fw->cfg = cfg;
     fw->name = name;
-    for (int i = 0; i < MAP_COUNT; i++)
-        if (frame_kind(i) && o->have_maps && o->maps[i])
-            fw->kinds[fw->n_kinds++] = map_names[i];
+    for (int i = 0; i < FS_MAP_COUNT; i++)
+        if (fs_map_is_raster(i) && o->have_maps && o->maps[i])
+            fw->kinds[fw->n_kinds++] = fs_map_name(i);
     if (fw->n_kinds == 0) {
-        fw->kinds[fw->n_kinds++] = map_names[MAP_BASECOLOR];
-        fw->kinds[fw->n_kinds++] = map_names[MAP_CRACKMASK];
+        fw->kinds[fw->n_kinds++] = fs_map_name(FS_MAP_BASECOLOR);
+        fw->kinds[fw->n_kinds++] = fs_map_name(FS_MAP_CRACKMASK);
     }
 }
 
@@ -432,19 +474,18 @@ static int write_frame(void *ctx, int32_t k, int32_t count, double t, const fs_s
     }
     fs_progress("frames", -1, "frame %d of %d at t = %.4g, %lld fractures", (int)k, (int)count, t,
                 (long long)stats->fractures);
-    fs_domain d = cfg->domain;
-    fs_domain_normalize(&d);
-    bool wu = fs_domain_wraps_u(&d), wv = fs_domain_wraps_v(&d);
-    fs_raster raster = {0};
-    fs_maps maps = {0};
-    int rc = fs_render_raster(surface, cfg->render.width, cfg->render.height, cfg->render.supersample, wu, wv,
-                              &raster);
-    if (rc == 0)
-        rc = fs_maps_build(&raster, &cfg->render, wu, wv, stats->extent_u / cfg->render.width,
-                           stats->extent_v / cfg->render.height, &maps);
+    bool kinds[FS_MAP_COUNT] = {false};
+    fs_outputs built;
+    fs_config frame_cfg = *cfg; /* a mesh domain's cm per texture unit are known once it is read */
+    if (frame_cfg.domain.type == FS_DOMAIN_MESH) {
+        frame_cfg.domain.width = stats->extent_u;
+        frame_cfg.domain.height = stats->extent_v;
+    }
+    int rc = fs_outputs_build(surface, &frame_cfg, kinds, false, &built);
     char stem[560];
     snprintf(stem, sizeof stem, "%s_frame_%04d", fw->name, (int)k);
-    fs_target_inputs in = {.maps = &maps, .height = &maps.height, .height_ext = "png", .normal = cfg->render.normal};
+    fs_target_inputs in = {.maps = &built.maps, .height = &built.maps.height, .height_ext = "png",
+                           .normal = cfg->render.normal};
     fs_target_output *w = fs_calloc(1, sizeof *w);
     if (rc == 0)
         rc = fs_target_write(fw->out, FS_TARGET_GENERIC, stem, fw->kinds, fw->n_kinds, &in, w);
@@ -461,125 +502,43 @@ static int write_frame(void *ctx, int32_t k, int32_t count, double t, const fs_s
     }
     fw->time[k - 1] = t;
     fw->fractures[k - 1] = stats->fractures;
-    fw->height_min[k - 1] = maps.height_min_cm;
-    fw->height_max[k - 1] = maps.height_max_cm;
+    fw->height_min[k - 1] = built.maps.height_min_cm;
+    fw->height_max[k - 1] = built.maps.height_max_cm;
     fs_target_output_free(w);
     free(w);
-    fs_maps_free(&maps);
-    fs_raster_free(&raster);
+    fs_outputs_free(&built);
     return rc;
 }
 
-/* Writes the selected maps, the sidecar and the --mesh file as one atomic output set; prints the
- * final paths. */
+/* Writes the run's outputs as one set (io/outputs.h) with the staged frames, and prints the final
+ * paths, the frames' first. */
 static int write_outputs(const options *o, const fs_config *cfg, const char *name, const char *preset_text,
-                         const fs_result *res, const fs_raster *raster, const fs_maps *maps, const fs_image *preview,
-                         frame_writer *fw, double t_start)
+                         const fs_result *res, const fs_outputs *built, frame_writer *fw, double t_start)
 {
-    fs_output *out = fs_output_begin(o->output_dir);
-    if (!out)
-        return -1;
-    fs_image exr_height = {0}, occlusion = {0};
-    fs_crackgraph cracks = {0};
-    fs_target_output *written = fs_calloc(1, sizeof *written);
-    fs_domain d = cfg->domain;
-    fs_domain_normalize(&d);
-    bool wu = fs_domain_wraps_u(&d), wv = fs_domain_wraps_v(&d);
-    int rc = 0;
-    if (o->maps[MAP_HEIGHT] && o->exr) {
-        /* Float height in cm at full precision, straight from the raster. */
-        fs_image_alloc(&exr_height, raster->width, raster->height, 1, FS_PIX_F32);
-        memcpy(exr_height.data, raster->height_cm, fs_image_bytes(&exr_height));
-    }
-    if (o->maps[MAP_OCCLUSION]) {
-        fs_occlusion_params op = fs_occlusion_params_default();
-        rc = fs_occlusion_build(raster, &op, wu, wv, &occlusion);
-    }
-    if (rc == 0 && o->maps[MAP_CRACKS]) {
-        double t_graph = fs_seconds();
-        fs_crackgraph_params cp = fs_crackgraph_params_default();
-        rc = fs_crackgraph_build(raster, wu, wv, &cp, &cracks);
-        fs_debug("crack graph: %d cracks, %d nodes, %d fragments in %.2f s", (int)cracks.n_edges,
-                 (int)cracks.n_nodes, (int)cracks.n_fragments, fs_seconds() - t_graph);
-    }
-    const char *kinds[MAP_COUNT];
-    int n_kinds = 0;
-    for (int i = 0; i < MAP_COUNT; i++)
-        if (o->maps[i])
-            kinds[n_kinds++] = map_names[i];
-    fs_target_inputs in = {.maps = maps,
-                           .height = o->exr ? &exr_height : &maps->height,
-                           .height_ext = o->exr ? "exr" : "png",
-                           .preview = preview,
-                           .occlusion = &occlusion,
-                           .roughness = cfg->render.roughness,
-                           .normal = cfg->render.normal,
-                           .cracks = &cracks};
-    if (rc == 0)
-        rc = fs_target_write(out, o->target, name, kinds, n_kinds, &in, written);
-    fs_image_free(&occlusion);
-    fs_crackgraph_free(&cracks);
-    fs_output *mesh_out = NULL, *asset_out = NULL;
-    fs_config lift_cfg = *cfg; /* the lift needs the domain as read (a mesh domain's texture size) */
-    lift_cfg.domain = res->mesh.domain;
-    fs_asset_inputs asset = {o->mesh_path, o->asset_path, &res->surface, &lift_cfg, name, o->output_dir, out,
-                             written->map, written->n, fs_target_name(o->target), maps->height_min_cm,
-                             maps->height_max_cm};
-    if (rc == 0)
-        rc = fs_asset_stage(&asset, &mesh_out, &asset_out);
-    const int n = written->n;
-    char asset_files[4][1024], asset_paths[4][1024];
-    int n_asset = rc == 0 ? fs_asset_files(&asset, written->map + n, asset_files, asset_paths) : 0;
-    written->n += n_asset;
-    char json_name[600];
-    snprintf(json_name, sizeof json_name, "%s.json", name);
     char frame_pattern[600];
     snprintf(frame_pattern, sizeof frame_pattern, "%s_frame_NNNN_KIND.png", name);
     fs_sidecar_frames frames = {o->frames, frame_pattern, fw->time, fw->fractures, fw->height_min, fw->height_max,
                                 fw->map, fw->n_kinds};
-    if (rc == 0)
-        rc = fs_sidecar_write(fs_output_stage(out, json_name), cfg, preset_text, &res->stats, maps,
-                              fs_target_name(o->target), written->map, written->n, o->frames ? &frames : NULL,
-                              fs_seconds() - t_start);
-    fs_target_output_free(written);
-    if (rc < 0) {
-        free(written);
-        fs_image_free(&exr_height);
-        fs_output_abort(out);
-        fs_output_abort(mesh_out);
-        fs_output_abort(asset_out);
-        return -1;
-    }
-    fs_image_free(&exr_height);
-    if (fs_output_commit(out) < 0) {
-        free(written);
-        fs_output_abort(mesh_out);
-        fs_output_abort(asset_out);
-        return -1;
-    }
-    if (mesh_out && fs_output_commit(mesh_out) < 0) {
-        free(written);
-        fs_output_abort(asset_out);
-        return -1;
-    }
-    if (asset_out && fs_output_commit(asset_out) < 0) {
-        free(written);
-        return -1;
-    }
-    fs_output *frames_out = fw->out;
+    fs_outputs_request r = {.output_dir = o->output_dir,
+                            .name = name,
+                            .exr = o->exr,
+                            .target = o->target,
+                            .mesh_path = o->mesh_path,
+                            .asset_path = o->asset_path,
+                            .preset_text = preset_text,
+                            .frames = fw->out,
+                            .frame_info = o->frames ? &frames : NULL,
+                            .t_start = t_start};
+    memcpy(r.kinds, o->maps, sizeof r.kinds);
     fw->out = NULL;
-    if (frames_out && fs_output_commit(frames_out) < 0) {
-        free(written);
+    fs_outputs_paths paths;
+    if (fs_outputs_write(built, &res->surface, cfg, &res->stats, &r, &paths) < 0)
         return -1;
-    }
     for (int i = 0; i < fw->n_files; i++)
         printf("%s/%s\n", o->output_dir, fw->file[i]);
-    for (int i = 0; i < n; i++)
-        printf("%s/%s\n", o->output_dir, written->file[i]);
-    free(written);
-    printf("%s/%s\n", o->output_dir, json_name);
-    for (int i = 0; i < n_asset; i++)
-        printf("%s\n", asset_paths[i]);
+    for (int i = 0; i < paths.n; i++)
+        printf("%s\n", paths.path[i]);
+    fs_outputs_paths_free(&paths);
     return 0;
 }
 
@@ -602,13 +561,7 @@ static int run(const char *preset_arg, const options *o)
         return usage_error("--frames: %s", "the voronoi model has no time to show frames of; expected a springs or "
                                            "wedge preset");
     }
-    char *preset_text = read_text(preset_path);
     const char *name = o->name ? o->name : cfg.preset.name;
-    fs_info("%s: %s model on a %s, %d elements, seed %" PRIu64 ", %dx%d maps", preset_path,
-            fs_model_name(cfg.preset.model), fs_domain_type_name(cfg.domain.type), (int)cfg.mesh.elements,
-            cfg.preset.seed, cfg.render.width, cfg.render.height);
-    free(preset_path);
-
     /* --mesh and --asset paths may hold {name}, for batches */
     options named = *o;
     char *mesh_path = o->mesh_path ? fs_job_expand_name(o->mesh_path, name) : NULL;
@@ -616,37 +569,41 @@ static int run(const char *preset_arg, const options *o)
     named.mesh_path = mesh_path;
     named.asset_path = asset_path;
     o = &named;
+    if (check_outputs(o, name) < 0) {
+        free(preset_path);
+        free(mesh_path);
+        free(asset_path);
+        return fail();
+    }
+    char *preset_text = fs_preset_read_text(preset_path);
+    fs_error_clear();
+    fs_info("%s: %s model on a %s, %d elements, seed %" PRIu64 ", %dx%d maps", preset_path,
+            fs_model_name(cfg.preset.model), fs_domain_type_name(cfg.domain.type), (int)cfg.mesh.elements,
+            cfg.preset.seed, cfg.render.width, cfg.render.height);
+    free(preset_path);
 
     fs_result res;
-    fs_raster raster = {0};
-    fs_maps maps = {0};
-    fs_image preview = {0};
+    fs_outputs built = {0};
     frame_writer fw;
     frame_writer_init(&fw, o, &cfg, name);
     fs_sim_frames frames = {o->frames, write_frame, &fw};
     int rc = fs_sim_run_frames(&cfg, o->frames > 0 ? &frames : NULL, &res);
     if (rc == 0) {
-        fs_domain d = res.mesh.domain; /* a mesh domain's texture size is known once it is read */
-        bool wu = fs_domain_wraps_u(&d), wv = fs_domain_wraps_v(&d);
+        if (cfg.domain.type == FS_DOMAIN_MESH)
+            cfg.domain = res.mesh.domain; /* a mesh domain's texture size is known once it is read */
         fs_progress("render", -1, "%dx%d, %d triangles", cfg.render.width, cfg.render.height,
                     (int)res.surface.n_tris);
-        double t_render = fs_seconds();
-        rc = fs_render_raster(&res.surface, cfg.render.width, cfg.render.height, cfg.render.supersample, wu, wv,
-                              &raster);
-        if (rc == 0)
-            rc = fs_maps_build(&raster, &cfg.render, wu, wv, fs_domain_extent_x(&d) / cfg.render.width,
-                               fs_domain_extent_y(&d) / cfg.render.height, &maps);
-        if (rc == 0 && o->maps[MAP_PREVIEW])
-            rc = fs_render_preview(&res.surface, &d, &cfg.render, &maps, &preview);
+        rc = fs_outputs_build(&res.surface, &cfg, o->maps, o->exr, &built);
         fs_progress_done();
-        fs_debug("rendered in %.2f s", fs_seconds() - t_render);
+        fs_debug("rendered in %.2f s (raster %.2f s, maps %.2f s, preview %.2f s, occlusion %.2f s, crack graph "
+                 "%.2f s)", built.render_seconds + built.maps_seconds + built.preview_seconds +
+                 built.occlusion_seconds + built.cracks_seconds, built.render_seconds, built.maps_seconds,
+                 built.preview_seconds, built.occlusion_seconds, built.cracks_seconds);
         if (rc == 0)
-            rc = write_outputs(o, &cfg, name, preset_text, &res, &raster, &maps, &preview, &fw, t_start);
+            rc = write_outputs(o, &cfg, name, preset_text, &res, &built, &fw, t_start);
         fs_result_free(&res);
     }
-    fs_maps_free(&maps);
-    fs_image_free(&preview);
-    fs_raster_free(&raster);
+    fs_outputs_free(&built);
     frame_writer_free(&fw);
     free(preset_text);
     free(mesh_path);
@@ -687,14 +644,30 @@ static int run_job(options *o, int n_args)
     return rc;
 }
 
+/* Runs before the shared libraries' constructors, some of which start threads (OpenBLAS its pool):
+ * blocking the termination signals here gives every thread of the process the blocked mask, so
+ * that only fissure's cleanup thread takes them (io/output.h). */
+static void block_signals_early(int argc, char **argv, char **envp)
+{
+    (void)argc;
+    (void)argv;
+    (void)envp;
+    fs_output_block_signals();
+}
+__attribute__((section(".preinit_array"), used)) static void (*const preinit_block_signals)(int, char **,
+                                                                                          char **) = block_signals_early;
+
 int main(int argc, char **argv)
 {
+    /* every mode: the termination signals are blocked from the preinit array on, and taken here */
+    if (fs_output_cleanup_on_signals() < 0)
+        return fail();
     if (argc > 1 && !strcmp(argv[1], "diff"))
         return fs_cli_diff(argc - 1, argv + 1);
 
     options o = {.output_dir = "."};
-    for (int i = 0; i < MAP_COUNT; i++)
-        o.maps[i] = i != MAP_PREVIEW;
+    for (int i = 0; i < FS_MAP_COUNT; i++)
+        o.maps[i] = i != FS_MAP_PREVIEW;
     int rc = parse_options(argc, argv, &o);
     if (rc != 0) {
         free(o.sets);

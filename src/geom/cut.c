@@ -118,7 +118,8 @@ int fs_cut_update_adjacency(fs_cut *c)
     fs_mesh *m = c->mesh;
     int32_t n_new = c->n_tris_adj - c->n_tris_before;
     int32_t *list = fs_malloc(((size_t)c->n_changed + (size_t)n_new + 1) * sizeof *list);
-    memcpy(list, c->changed_list, (size_t)c->n_changed * sizeof *list);
+    if (c->n_changed > 0)
+        memcpy(list, c->changed_list, (size_t)c->n_changed * sizeof *list);
     for (int32_t q = 0; q < n_new; q++)
         list[c->n_changed + q] = c->n_tris_before + q;
     int rc = fs_mesh_update_adjacency(m, c->n_tris_adj, list, c->n_changed + n_new);

@@ -524,16 +524,24 @@ static void block_region(const plane_setup *s, int b, double margin, double *lo,
     hi[a] = (b == s->nblocks - 1 && !wraps) ? INFINITY : s->cut0 + (b + 1) * s->cut_width + margin;
 }
 
+/* Most periodic copies of one point per direction that a block makes. */
+#define MAX_IMAGES 100
+
 /* Range [k0, k1] of image shifts k with lo <= x + k period < hi (k = 0 only, if it fits, for a
- * direction that does not wrap). Returns false when empty. */
-static bool image_range(double x, double period, double lo, double hi, int *k0, int *k1)
+ * direction that does not wrap). Returns 0 when empty, 1 when not, and -1 when the range holds more
+ * than MAX_IMAGES shifts (a period tiny beside the margin: the shifts are counted in double
+ * precision, so no count overflows an int). */
+static int image_range(double x, double period, double lo, double hi, int *k0, int *k1)
 {
     if (period == 0.0) {
         *k0 = *k1 = 0;
         return x >= lo && x < hi;
     }
-    *k0 = (int)ceil((lo - x) / period);
-    *k1 = (int)ceil((hi - x) / period) - 1;
+    double a = ceil((lo - x) / period), b = ceil((hi - x) / period) - 1.0;
+    if (!(b - a <= MAX_IMAGES))
+        return -1;
+    *k0 = (int)a;
+    *k1 = (int)b;
     return *k0 <= *k1;
 }
 
@@ -569,17 +577,18 @@ static void run_block(block_job *job)
             count = 0;
             for (int32_t i = 0; i < n; i++) {
                 int k0[2], k1[2];
-                if (!image_range(s->base[2 * i], s->period[0], lo[0], hi[0], &k0[0], &k1[0]) ||
-                    !image_range(s->base[2 * i + 1], s->period[1], lo[1], hi[1], &k0[1], &k1[1]))
+                int in_x = image_range(s->base[2 * i], s->period[0], lo[0], hi[0], &k0[0], &k1[0]);
+                int in_y = image_range(s->base[2 * i + 1], s->period[1], lo[1], hi[1], &k0[1], &k1[1]);
+                if ((in_x == 0 && in_y >= 0) || (in_y == 0 && in_x >= 0))
                     continue;
-                if (k1[0] - k0[0] > 100 || k1[1] - k0[1] > 100) {
+                if (in_x < 0 || in_y < 0) {
                     free(xy);
                     free(node);
                     free(shift);
                     fs_error(FS_ERR_DATA,
                              "delaunay: %d points are too few for a periodic domain this elongated: the "
-                             "triangulation would need more than 100 periodic copies",
-                             (int)n);
+                             "triangulation would need more than %d periodic copies",
+                             (int)n, MAX_IMAGES);
                     block_fail(job);
                     return;
                 }

@@ -672,17 +672,29 @@ static void relax_step(relax_state *s, double step, double maxmove)
     fs_parallel_for(s->nthreads, s->nthreads, move_particles, task);
 }
 
-static int32_t cells_along(double ext, double dmax)
+/* Most cells of a grid of n points: a few per point. Cells at least dmax wide can be far more when
+ * the domain is extremely elongated, or so small that dmax underflows; wider cells only put more
+ * pairs in a cell, never miss a neighbour, so the count is capped instead. */
+static int64_t grid_cell_budget(int32_t n)
 {
-    double m = floor(ext / dmax);
-    return m < 1.0 ? 1 : (m > 1.0e6 ? 1000000 : (int32_t)m);
+    return 4 * (int64_t)n + 64;
 }
 
-/* 2-D grid: cells at least dmax wide, a whole number of them across each side. */
+/* Cells across a side of extent ext: as many as fit at least dmax wide, at least 1, at most `most`. */
+static int32_t cells_along(double ext, double dmax, int64_t most)
+{
+    double m = floor(ext / dmax);
+    if (!(m >= 1.0))
+        return 1;
+    return m > (double)most ? (int32_t)most : (int32_t)m;
+}
+
+/* 2-D grid: cells at least dmax wide (unless capped), a whole number of them across each side. */
 static void setup_grid_2d(relax_state *s, double dmax)
 {
-    s->dim[0] = cells_along(s->ext[0], dmax);
-    s->dim[1] = cells_along(s->ext[1], dmax);
+    int64_t budget = grid_cell_budget(s->n);
+    s->dim[0] = cells_along(s->ext[0], dmax, budget);
+    s->dim[1] = cells_along(s->ext[1], dmax, budget / s->dim[0]);
     s->dim[2] = 1;
     s->inv_cell = s->dim[0] / s->ext[0];
     s->inv_cell_y = s->dim[1] / s->ext[1];
@@ -690,13 +702,13 @@ static void setup_grid_2d(relax_state *s, double dmax)
     s->n_buckets = s->dim[0] * s->dim[1];
 }
 
-/* Sphere grid: the cube [-R, R]^3 in cells at least dmax wide; per column, the runs of cells the
- * sphere passes through (from the range of distances of the column to the z axis), widened by a
- * small margin against rounding. */
+/* Sphere grid: the cube [-R, R]^3 in cells at least dmax wide (at most the cell budget of columns);
+ * per column, the runs of cells the sphere passes through (from the range of distances of the column
+ * to the z axis), widened by a small margin against rounding. */
 static void setup_grid_sphere(relax_state *s, double dmax)
 {
     double R = s->radius, side = 2.0 * R;
-    int32_t m = cells_along(side, dmax);
+    int32_t m = cells_along(side, dmax, (int64_t)floor(sqrt((double)grid_cell_budget(s->n))));
     double c = side / m, eps = 1e-6 * c;
     s->dim[0] = s->dim[1] = s->dim[2] = m;
     s->inv_cell = m / side;

@@ -9,6 +9,10 @@ extern "C" {
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -16,7 +20,9 @@ extern "C" {
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <iostream>
 #include <limits>
+#include <string>
 #include <vector>
 
 /* zlib level 6: the usual size/speed balance (OpenCV's default of 1 gives much larger maps). */
@@ -150,19 +156,130 @@ static int image_from_mat(const cv::Mat &m, const char *path, fs_image *out)
     return 0;
 }
 
-/* Decodes path into a Mat; missing/unopenable files and undecodable contents are told apart. */
-static int decode_file(const char *path, cv::Mat *m)
+/* design: libpng, libjpeg, OpenEXR and OpenCV report their errors by printing them on stderr
+ * ("libpng error: IDAT: CRC error", OpenCV's "[ WARN...]" lines) before returning failure, which put
+ * raw lines ahead of fissure's own message. While a codec runs, file descriptor 2 points to an
+ * anonymous temporary file; what the codec printed becomes part of fissure's message when it
+ * fails, and is dropped when it succeeds. The codecs run on the calling thread while no other
+ * thread of fissure prints. */
+class stderr_capture {
+  public:
+    stderr_capture()
+    {
+        fflush(stderr);
+        tmp_ = tmpfile();
+        if (!tmp_)
+            return;
+        saved_ = dup(2);
+        if (saved_ < 0 || dup2(fileno(tmp_), 2) < 0) {
+            if (saved_ >= 0)
+                close(saved_);
+            saved_ = -1;
+            fclose(tmp_);
+            tmp_ = NULL;
+        }
+    }
+    ~stderr_capture() { restore(); }
+    /* Puts stderr back and returns the last line the codec printed ("" if none). */
+    std::string restore()
+    {
+        std::string last;
+        if (!tmp_)
+            return last;
+        fflush(stderr);
+        std::cerr.flush();
+        dup2(saved_, 2);
+        close(saved_);
+        char buf[4096];
+        rewind(tmp_);
+        size_t n = fread(buf, 1, sizeof buf - 1, tmp_);
+        buf[n] = '\0';
+        fclose(tmp_);
+        tmp_ = NULL;
+        std::string text(buf);
+        while (!text.empty() && (text.back() == '\n' || text.back() == ' '))
+            text.pop_back();
+        size_t nl = text.rfind('\n');
+        last = nl == std::string::npos ? text : text.substr(nl + 1);
+        return last;
+    }
+
+  private:
+    FILE *tmp_ = NULL;
+    int saved_ = -1;
+};
+
+/* Reads a whole regular file of at most FS_IMAGE_MAX_FILE_BYTES into bytes; missing or irregular
+ * files (FS_ERR_NOINPUT) and read failures (FS_ERR_IO) are told apart. The open does not block on a
+ * FIFO, and the checks are on the opened file. */
+static int read_bytes(const char *path, std::vector<unsigned char> *bytes)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) {
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0) {
         fs_error(FS_ERR_NOINPUT, "%s: cannot open image: %s", path, strerror(errno));
         return -1;
     }
-    fclose(f);
+    struct stat st;
+    int status = fstat(fd, &st) != 0 ? errno : S_ISDIR(st.st_mode) ? EISDIR : 0;
+    if (status != 0 || !S_ISREG(st.st_mode)) {
+        fs_error(FS_ERR_NOINPUT, "%s: cannot open image: %s", path, status ? strerror(status) : "not a regular file");
+        close(fd);
+        return -1;
+    }
+    if (st.st_size > FS_IMAGE_MAX_FILE_BYTES) {
+        fs_error(FS_ERR_DATA, "%s: image file of %lld bytes: expected at most %lld", path, (long long)st.st_size,
+                 (long long)FS_IMAGE_MAX_FILE_BYTES);
+        close(fd);
+        return -1;
+    }
+    bytes->resize((size_t)st.st_size);
+    size_t got = 0;
+    while (got < bytes->size()) {
+        ssize_t r = read(fd, bytes->data() + got, bytes->size() - got);
+        if (r < 0 && (errno == EINTR || errno == EAGAIN))
+            continue;
+        if (r <= 0) {
+            int err = r < 0 ? errno : 0;
+            fs_error(FS_ERR_IO, "%s: cannot read image: %s", path, err ? strerror(err) : "the file got shorter");
+            close(fd);
+            return -1;
+        }
+        got += (size_t)r;
+    }
+    close(fd);
+    return 0;
+}
+
+/* Decodes an image in memory into a Mat after checking its header: a format fissure reads and at
+ * most max_pixels, refused before any decoding. */
+static int decode_bytes(const std::vector<unsigned char> &bytes, const char *origin, int64_t max_pixels, cv::Mat *m)
+{
+    fs_image_header h;
+    if (fs_image_probe(bytes.data(), bytes.size(), &h) != 0) {
+        if (!h.format)
+            fs_error(FS_ERR_DATA, "%s: not an image fissure reads: expected PNG, JPEG, TIFF, OpenEXR, WebP, BMP or PNM",
+                     origin);
+        else
+            fs_error(FS_ERR_DATA, "%s: %s image without a valid size in its header", origin, h.format);
+        return -1;
+    }
+    if (h.width > FS_IMAGE_MAX_PIXELS || h.height > FS_IMAGE_MAX_PIXELS || h.width * h.height > max_pixels) {
+        fs_error(FS_ERR_DATA, "%s: %s image of %lld x %lld pixels: expected at most %lld pixels", origin, h.format,
+                 (long long)h.width, (long long)h.height, (long long)max_pixels);
+        return -1;
+    }
     enable_exr();
-    *m = cv::imread(path, cv::IMREAD_UNCHANGED);
+    stderr_capture capture;
+    *m = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+    std::string said = capture.restore();
     if (m->empty()) {
-        fs_error(FS_ERR_DATA, "%s: not an image in a format that can be read", path);
+        fs_error(FS_ERR_DATA, "%s: cannot decode the %s image%s%s", origin, h.format, said.empty() ? "" : ": ",
+                 said.c_str());
+        return -1;
+    }
+    if ((int64_t)m->cols != h.width || (int64_t)m->rows != h.height) {
+        fs_error(FS_ERR_DATA, "%s: the %s image decodes to %d x %d pixels, its header says %lld x %lld", origin,
+                 h.format, m->cols, m->rows, (long long)h.width, (long long)h.height);
         return -1;
     }
     return 0;
@@ -172,8 +289,9 @@ extern "C" int fs_image_read(const char *path, fs_image *out)
 {
     memset(out, 0, sizeof *out);
     try {
+        std::vector<unsigned char> bytes;
         cv::Mat m;
-        if (decode_file(path, &m) != 0)
+        if (read_bytes(path, &bytes) != 0 || decode_bytes(bytes, path, FS_IMAGE_MAX_PIXELS, &m) != 0)
             return -1;
         return image_from_mat(m, path, out);
     } catch (const cv::Exception &e) {
@@ -186,41 +304,73 @@ extern "C" int fs_image_read(const char *path, fs_image *out)
     return -1;
 }
 
-extern "C" int fs_image_read_grey(const char *path, int *width, int *height, float **grey)
+/* Grey levels in [0, 1] of a decoded Mat, row by row (no float copy of the whole image). */
+static float *grey_from_mat(const cv::Mat &m)
+{
+    double scale = 1.0;
+    if (m.depth() == CV_8U)
+        scale = 1.0 / 255.0;
+    else if (m.depth() == CV_16U)
+        scale = 1.0 / 65535.0;
+    int channels = m.channels();
+    /* Colour is averaged over R, G, B (alpha, when present, is ignored). */
+    int colour = channels >= 3 ? 3 : 1;
+    size_t n = (size_t)m.cols * (size_t)m.rows;
+    float *g = (float *)fs_malloc(n * sizeof(float));
+    cv::Mat row_f;
+    for (int y = 0; y < m.rows; y++) {
+        m.row(y).convertTo(row_f, CV_MAKETYPE(CV_32F, channels), scale);
+        const float *row = row_f.ptr<float>(0);
+        for (int x = 0; x < m.cols; x++) {
+            double sum = 0.0;
+            for (int c = 0; c < colour; c++)
+                sum += row[(size_t)x * (size_t)channels + (size_t)c];
+            g[(size_t)y * (size_t)m.cols + (size_t)x] = (float)(sum / colour);
+        }
+    }
+    return g;
+}
+
+static int decode_grey(const std::vector<unsigned char> &bytes, const char *origin, int *width, int *height,
+                       float **grey)
 {
     try {
         cv::Mat m;
-        if (decode_file(path, &m) != 0)
+        if (decode_bytes(bytes, origin, FS_IMAGE_MAX_MAP_PIXELS, &m) != 0)
             return -1;
-        double scale = 1.0;
-        if (m.depth() == CV_8U)
-            scale = 1.0 / 255.0;
-        else if (m.depth() == CV_16U)
-            scale = 1.0 / 65535.0;
-        int channels = m.channels();
-        cv::Mat f;
-        m.convertTo(f, CV_MAKETYPE(CV_32F, channels), scale);
-        /* Colour is averaged over R, G, B (alpha, when present, is ignored). */
-        int colour = channels >= 3 ? 3 : 1;
-        size_t n = (size_t)m.cols * (size_t)m.rows;
-        float *g = (float *)fs_malloc(n * sizeof(float));
-        for (int y = 0; y < m.rows; y++) {
-            const float *row = f.ptr<float>(y);
-            for (int x = 0; x < m.cols; x++) {
-                double sum = 0.0;
-                for (int c = 0; c < colour; c++)
-                    sum += row[(size_t)x * (size_t)channels + (size_t)c];
-                g[(size_t)y * (size_t)m.cols + (size_t)x] = (float)(sum / colour);
-            }
-        }
+        *grey = grey_from_mat(m);
         *width = m.cols;
         *height = m.rows;
-        *grey = g;
         return 0;
     } catch (const cv::Exception &e) {
-        fs_error(FS_ERR_DATA, "%s: cannot decode image: %s", path, e.what());
+        fs_error(FS_ERR_DATA, "%s: cannot decode image: %s", origin, e.what());
     } catch (const std::exception &e) {
-        fs_error(FS_ERR_INTERNAL, "%s: cannot decode image: %s", path, e.what());
+        fs_error(FS_ERR_INTERNAL, "%s: cannot decode image: %s", origin, e.what());
+    }
+    return -1;
+}
+
+extern "C" int fs_image_read_grey(const char *path, int *width, int *height, float **grey)
+{
+    try {
+        std::vector<unsigned char> bytes;
+        if (read_bytes(path, &bytes) != 0)
+            return -1;
+        return decode_grey(bytes, path, width, height, grey);
+    } catch (const std::exception &e) {
+        fs_error(FS_ERR_INTERNAL, "%s: cannot read image: %s", path, e.what());
+    }
+    return -1;
+}
+
+extern "C" int fs_image_decode_grey(const unsigned char *data, size_t n, const char *origin, int *width, int *height,
+                                    float **grey)
+{
+    try {
+        std::vector<unsigned char> bytes(data, data + n);
+        return decode_grey(bytes, origin, width, height, grey);
+    } catch (const std::exception &e) {
+        fs_error(FS_ERR_INTERNAL, "%s: cannot decode image: %s", origin, e.what());
     }
     return -1;
 }
@@ -321,16 +471,28 @@ extern "C" int fs_image_write_tagged(const char *path, const fs_image *img, fs_i
             params.push_back(cv::IMWRITE_EXR_TYPE);
             params.push_back(cv::IMWRITE_EXR_TYPE_FLOAT);
         }
-        if (png && tag == FS_IMAGE_SRGB) {
+        /* PNG is encoded in memory and written here, so that a failed write says why (libpng's
+         * own writer only printed "libpng error: Write Error"). OpenEXR has no memory encoder in
+         * OpenCV: it writes the file itself, and its failure is reported with errno as the failed
+         * write left it. */
+        stderr_capture capture;
+        if (png) {
             std::vector<unsigned char> bytes;
-            if (!cv::imencode(".png", m, bytes, params) || !insert_srgb_chunk(bytes)) {
-                fs_error(FS_ERR_INTERNAL, "%s: cannot encode PNG", path);
+            bool encoded = cv::imencode(".png", m, bytes, params) && (tag != FS_IMAGE_SRGB || insert_srgb_chunk(bytes));
+            std::string said = capture.restore();
+            if (!encoded) {
+                fs_error(FS_ERR_INTERNAL, "%s: cannot encode PNG%s%s", path, said.empty() ? "" : ": ", said.c_str());
                 return -1;
             }
             return write_bytes(path, bytes);
         }
-        if (!cv::imwrite(path, m, params)) {
-            fs_error(FS_ERR_IO, "%s: cannot write image", path);
+        errno = 0;
+        bool written = cv::imwrite(path, m, params);
+        int err = errno;
+        std::string said = capture.restore();
+        if (!written) {
+            fs_error(FS_ERR_IO, "%s: cannot write image: %s%s%s", path, strerror(err ? err : EIO),
+                     said.empty() ? "" : "; ", said.c_str());
             return -1;
         }
         return 0;

@@ -25,12 +25,39 @@ void fs_image_alloc(fs_image *img, int width, int height, int channels, fs_pixel
 void fs_image_free(fs_image *img);
 size_t fs_image_bytes(const fs_image *img);
 
-/* Reads PNG/EXR/any format OpenCV reads, keeping bit depth and channels (BGR converted to RGB).
- * Returns 0, or -1 with fs_error(FS_ERR_NOINPUT) for a missing file, FS_ERR_DATA for an unreadable one. */
+/* Most pixels of an image fs_image_read decodes: the largest map fissure writes (16384 x 16384). */
+#define FS_IMAGE_MAX_PIXELS ((int64_t)16384 * 16384)
+/* Most pixels of a grey-level input map (fs_image_read_grey), 8192 x 8192 or any other shape of as
+ * many: a map is averaged over elements, and decoding one costs up to 12 bytes a pixel. */
+#define FS_IMAGE_MAX_MAP_PIXELS ((int64_t)8192 * 8192)
+/* Largest image file read. */
+#define FS_IMAGE_MAX_FILE_BYTES ((int64_t)1 << 30)
+
+/* The format and size an image file declares in its header. */
+typedef struct {
+    const char *format;    /* "PNG", "JPEG", "TIFF", "OpenEXR", "WebP", "BMP", "PNM"; NULL if unknown */
+    int64_t width, height; /* as declared, 0 when the header gives none that can be read */
+} fs_image_header;
+
+/* Reads the format and size from the first bytes of an image (data, n bytes), without decoding.
+ * Returns 0, or -1 for an unknown format (format NULL) or a header without a readable size (format
+ * set, sizes 0). Implemented in probe.c (no library). */
+int fs_image_probe(const unsigned char *data, size_t n, fs_image_header *out);
+
+/* Reads a PNG, JPEG, TIFF, OpenEXR, WebP, BMP or PNM file (a regular file of at most
+ * FS_IMAGE_MAX_FILE_BYTES, whose header declares at most FS_IMAGE_MAX_PIXELS), keeping bit depth
+ * and channels (BGR converted to RGB). The size is checked from the header before decoding.
+ * Returns 0, or -1 with fs_error(FS_ERR_NOINPUT) for a missing or irregular file, FS_ERR_DATA for
+ * an unreadable, unknown or too large one (the decoder's own message included). */
 int fs_image_read(const char *path, fs_image *out);
 
-/* Reads an image as grey levels in [0, 1] (any depth, colour averaged). */
+/* Reads an image as grey levels in [0, 1] (any depth, colour averaged), as fs_image_read does but
+ * with at most FS_IMAGE_MAX_MAP_PIXELS. */
 int fs_image_read_grey(const char *path, int *width, int *height, float **grey);
+
+/* fs_image_read_grey of an image in memory (data, n bytes); `origin` names it in messages. */
+int fs_image_decode_grey(const unsigned char *data, size_t n, const char *origin, int *width, int *height,
+                         float **grey);
 
 /* Writes the image to exactly `path` (format from its extension: .png, .exr). Not atomic by itself:
  * io/output.h stages files under temporary names. Returns 0 or -1 with fs_error(FS_ERR_IO). */

@@ -175,10 +175,12 @@ int fs_cracks_write_json(const char *path, const fs_crackgraph *g)
     }
     fs_json_set(root, "adjacency", adj);
 
+    errno = 0;
     int rc = fs_json_write(root, path, (fs_json_format){1, 10});
+    int err = errno;
     fs_json_free(root);
     if (rc != 0) {
-        fs_error(FS_ERR_IO, "%s: cannot write the crack graph", path);
+        fs_error(FS_ERR_IO, "%s: cannot write the crack graph: %s", path, strerror(err ? err : EIO));
         return -1;
     }
     return 0;
@@ -229,10 +231,5 @@ int fs_cracks_write_svg(const char *path, const fs_crackgraph *g)
                 n->kind == FS_CRACK_JUNCTION ? 2.5 : 2.0, node_colour(n));
     }
     fprintf(f, "</g>\n</svg>\n");
-    bool bad = ferror(f) != 0;
-    if (fclose(f) != 0 || bad) {
-        fs_error(FS_ERR_IO, "%s: cannot write the crack graph", path);
-        return -1;
-    }
-    return 0;
+    return fs_close_written(f, path, "the crack graph");
 }

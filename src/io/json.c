@@ -39,6 +39,13 @@ fs_json *fs_json_string(const char *s)
     return wrap(v ? v : json_null());
 }
 
+bool fs_json_valid_utf8(const char *s)
+{
+    json_t *v = s ? json_string(s) : NULL;
+    json_decref(v);
+    return v != NULL;
+}
+
 fs_json *fs_json_real(double v)
 {
     return wrap(isfinite(v) ? json_real(v) : json_null());
@@ -70,6 +77,27 @@ size_t fs_json_size(const fs_json *v)
 {
     json_t *j = unwrap(v);
     return json_is_array(j) ? json_array_size(j) : json_is_object(j) ? json_object_size(j) : 0;
+}
+
+fs_json *fs_json_at(fs_json *array, size_t i)
+{
+    return (fs_json *)json_array_get(unwrap(array), i);
+}
+
+const char *fs_json_text(const fs_json *v)
+{
+    return json_string_value(unwrap(v));
+}
+
+double fs_json_number(const fs_json *v)
+{
+    json_t *j = unwrap(v);
+    return json_is_number(j) ? json_number_value(j) : NAN;
+}
+
+fs_json *fs_json_read(const char *path)
+{
+    return (fs_json *)json_load_file(path, 0, NULL);
 }
 
 static size_t flags(fs_json_format fmt)

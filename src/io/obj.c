@@ -162,11 +162,5 @@ int fs_obj_write(const char *path, const fs_lifted_mesh *m, const char *name, co
     put_group(&w, m, "walls", 1);
     flush(&w);
     free(w.buf);
-    bool failed = ferror(f) != 0;
-    failed = fclose(f) != 0 || failed;
-    if (failed) {
-        fs_error(FS_ERR_IO, "%s: cannot write the mesh file", path);
-        return -1;
-    }
-    return 0;
+    return fs_close_written(f, path, "the mesh file");
 }

@@ -4,6 +4,7 @@
 #include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <ini.h>
 #include <math.h>
 #include <stdarg.h>
@@ -176,6 +177,72 @@ static const key_def key_table[] = {
 
 static const char *const syntax_message = "syntax error: expected 'key = value' or '[section]'";
 
+/* Largest preset file read (fissure-preset(5)). Presets are a few kilobytes; the cap keeps a huge
+ * or endless file from being read into memory without end. */
+#define PRESET_MAX_BYTES (1024 * 1024)
+
+/* file_status for something that exists but is neither a regular file nor a directory (a device,
+ * a FIFO, a socket): reading it could block or never end. */
+#define NOT_REGULAR (-1)
+
+static const char *status_text(int status)
+{
+    return status == NOT_REGULAR ? "not a regular file" : strerror(status);
+}
+
+/* Opens a preset for reading if it is a regular file of at most PRESET_MAX_BYTES. The open does not
+ * block (O_NONBLOCK: a FIFO would wait for a writer) and the checks are on the opened file. Returns
+ * the stream, or NULL with fs_error(FS_ERR_NOINPUT), or FS_ERR_DATA for a file over the cap. */
+static FILE *open_preset(const char *path)
+{
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0) {
+        fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: %s", path, strerror(errno));
+        return NULL;
+    }
+    struct stat st;
+    int status = fstat(fd, &st) != 0 ? errno : S_ISDIR(st.st_mode) ? EISDIR : !S_ISREG(st.st_mode) ? NOT_REGULAR : 0;
+    if (status != 0) {
+        fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: %s", path, status_text(status));
+        close(fd);
+        return NULL;
+    }
+    if (st.st_size > PRESET_MAX_BYTES) {
+        fs_error(FS_ERR_DATA, "%s: preset of %lld bytes: expected at most %d bytes (1 MiB)", path,
+                 (long long)st.st_size, PRESET_MAX_BYTES);
+        close(fd);
+        return NULL;
+    }
+    int flags = fcntl(fd, F_GETFL);
+    FILE *fp = flags == -1 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) == -1 ? NULL : fdopen(fd, "r");
+    if (!fp) {
+        fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: %s", path, strerror(errno));
+        close(fd);
+    }
+    return fp;
+}
+
+char *fs_preset_read_text(const char *path)
+{
+    FILE *fp = open_preset(path);
+    if (!fp)
+        return NULL;
+    char *text = fs_malloc(PRESET_MAX_BYTES + 2);
+    size_t n = fread(text, 1, PRESET_MAX_BYTES + 1, fp);
+    bool failed = ferror(fp) != 0;
+    fclose(fp);
+    if (failed || n > PRESET_MAX_BYTES) {
+        if (failed)
+            fs_error(FS_ERR_IO, "%s: cannot read preset", path);
+        else
+            fs_error(FS_ERR_DATA, "%s: preset larger than %d bytes (1 MiB)", path, PRESET_MAX_BYTES);
+        free(text);
+        return NULL;
+    }
+    text[n] = '\0';
+    return fs_realloc(text, n + 1);
+}
+
 /* ---- small string helpers ---- */
 
 static char *trim(char *s)
@@ -241,10 +308,44 @@ static void section_keys(const char *section, char *buf, size_t size)
 
 /* ---- values ---- */
 
-/* A finite number, the whole string consumed. */
+/* Whether s is a decimal number as fissure-preset(5) defines it: an optional sign, digits with an
+ * optional decimal point (a digit on at least one side), an optional exponent e or E with an
+ * optional sign and digits. strtod alone also takes hexadecimal (0x10, 0x1p3), inf and nan. */
+static bool decimal_syntax(const char *s)
+{
+    const char *p = s;
+    if (*p == '+' || *p == '-')
+        p++;
+    int digits = 0;
+    while (isdigit((unsigned char)*p)) {
+        p++;
+        digits++;
+    }
+    if (*p == '.') {
+        p++;
+        while (isdigit((unsigned char)*p)) {
+            p++;
+            digits++;
+        }
+    }
+    if (digits == 0)
+        return false;
+    if (*p == 'e' || *p == 'E') {
+        p++;
+        if (*p == '+' || *p == '-')
+            p++;
+        if (!isdigit((unsigned char)*p))
+            return false;
+        while (isdigit((unsigned char)*p))
+            p++;
+    }
+    return *p == '\0';
+}
+
+/* A finite decimal number, the whole string consumed. */
 static int parse_real(const char *s, double *out)
 {
-    if (!*s || isspace((unsigned char)*s))
+    if (!decimal_syntax(s))
         return -1;
     char *end;
     double v = strtod(s, &end);
@@ -314,10 +415,13 @@ static void describe_number(const key_def *k, const char *what, char *buf, size_
     snprintf(buf, size, "%s%s%s", what, range, unit);
 }
 
-/* Whether the text survives being written as an INI value and read back: no control characters and
- * no ';' after white space (which inih takes for a comment). */
+/* Whether the text survives being written as an INI value ("key = value") and read back: no control
+ * characters, no ';' after white space (which inih takes for a comment), and no ';' first (the
+ * dump puts a space before the value, after which it would start a comment). */
 static bool representable(const char *s)
 {
+    if (*s == ';')
+        return false;
     for (const char *p = s; *p; p++) {
         if (iscntrl((unsigned char)*p))
             return false;
@@ -491,14 +595,14 @@ static int apply_value(fs_config *cfg, const key_def *k, const char *value, cons
             return -1;
         }
         if (!representable(value)) {
-            snprintf(why, why_size, "one line without control characters or ' ;' (a comment)");
+            snprintf(why, why_size, "one line without control characters, a leading ';' or ' ;' (a comment)");
             return -1;
         }
         strcpy(field, value);
         return 0;
     case KEY_PATH: {
         if (!representable(value)) {
-            snprintf(why, why_size, "a file name without control characters or ' ;' (a comment)");
+            snprintf(why, why_size, "a file name without control characters, a leading ';' or ' ;' (a comment)");
             return -1;
         }
         char path[FS_PATH_MAX];
@@ -841,6 +945,7 @@ typedef struct {
     char *line;            /* the current physical line */
     size_t cap;
     int lineno;
+    size_t bytes;          /* read so far from fp, at most PRESET_MAX_BYTES */
     const char *long_value; /* value of the current line when it did not fit inih's buffer */
     int key_line[N_KEYS];  /* line on which each key was set, 0 if not */
     bool failed;           /* err holds the first error found by the reader or the handler */
@@ -868,18 +973,40 @@ static void ctx_fail(parse_ctx *c, fs_errdomain domain, int line, const char *fm
 /* Reads the next physical line into c->line without its line break. Returns -1 at the end. */
 static int next_line(parse_ctx *c)
 {
-    size_t len;
+    size_t len = 0;
     if (c->fp) {
+        /* byte by byte, so that no line, however long, is read past the cap */
+        bool any = false, nul = false;
+        int ch;
         errno = 0;
-        ssize_t n = getline(&c->line, &c->cap, c->fp);
-        if (n < 0) {
-            if (ferror(c->fp))
-                ctx_fail(c, FS_ERR_IO, 0, "%s: cannot read preset: %s", c->origin, strerror(errno ? errno : EIO));
+        while ((ch = getc(c->fp)) != EOF) {
+            any = true;
+            if (++c->bytes > PRESET_MAX_BYTES) {
+                ctx_fail(c, FS_ERR_DATA, 0, "%s: preset larger than %d bytes (1 MiB)", c->origin, PRESET_MAX_BYTES);
+                return -1;
+            }
+            if (ch == '\n')
+                break;
+            nul |= ch == '\0';
+            if (len + 2 > c->cap) {
+                c->cap = c->cap ? 2 * c->cap : 256;
+                c->line = fs_realloc(c->line, c->cap);
+            }
+            c->line[len++] = (char)ch;
+        }
+        if (ferror(c->fp)) {
+            ctx_fail(c, FS_ERR_IO, 0, "%s: cannot read preset: %s", c->origin, strerror(errno ? errno : EIO));
             return -1;
         }
-        len = (size_t)n;
+        if (!any)
+            return -1;
+        if (!c->line) {
+            c->cap = 1;
+            c->line = fs_malloc(1);
+        }
+        c->line[len] = '\0';
         c->lineno++;
-        if (strlen(c->line) != len) {
+        if (nul) {
             ctx_fail(c, FS_ERR_DATA, c->lineno, "%s:%d: %s", c->origin, c->lineno, syntax_message);
             return -1;
         }
@@ -1072,17 +1199,9 @@ static char *file_dir(const char *path)
 
 int fs_preset_load(const char *path, fs_config *cfg)
 {
-    FILE *fp = fopen(path, "r");
-    if (!fp) {
-        fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: %s", path, strerror(errno));
+    FILE *fp = open_preset(path);
+    if (!fp)
         return -1;
-    }
-    struct stat st;
-    if (fstat(fileno(fp), &st) == 0 && S_ISDIR(st.st_mode)) {
-        fclose(fp);
-        fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: %s", path, strerror(EISDIR));
-        return -1;
-    }
     parse_ctx *c = fs_calloc(1, sizeof *c);
     c->cfg = cfg;
     c->origin = path;
@@ -1247,13 +1366,13 @@ static str_list preset_dirs(void)
     return dirs;
 }
 
-/* 0 when path names something other than a directory, else an errno value. */
+/* 0 when path names a regular file, else an errno value (EISDIR for a directory) or NOT_REGULAR. */
 static int file_status(const char *path)
 {
     struct stat st;
     if (stat(path, &st) != 0)
         return errno;
-    return S_ISDIR(st.st_mode) ? EISDIR : 0;
+    return S_ISDIR(st.st_mode) ? EISDIR : S_ISREG(st.st_mode) ? 0 : NOT_REGULAR;
 }
 
 static bool is_file(const char *path)
@@ -1372,27 +1491,30 @@ char *fs_preset_find(const char *name)
     if (status == 0)
         return fs_strdup(name);
     if (!*name || strchr(name, '/')) {
-        fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: %s", name, strerror(status));
+        fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: %s", name, status_text(status));
         return NULL;
     }
     str_list dirs = preset_dirs();
     char looked[768];
     size_t len = 0;
     looked[0] = '\0';
+    char *unreadable = NULL; /* the first file of the name on the path that is not a regular file */
+    int unreadable_status = 0;
     for (int i = 0; i < dirs.n; i++) {
-        char *p = path_join(dirs.items[i], name, "");
-        if (is_file(p)) {
-            list_free(&dirs);
-            return p;
-        }
-        free(p);
-        if (!has_ini_suffix(name)) {
-            p = path_join(dirs.items[i], name, ".ini");
-            if (is_file(p)) {
+        for (int with_ini = 0; with_ini < (has_ini_suffix(name) ? 1 : 2); with_ini++) {
+            char *p = path_join(dirs.items[i], name, with_ini ? ".ini" : "");
+            int st = file_status(p);
+            if (st == 0) {
                 list_free(&dirs);
+                free(unreadable);
                 return p;
             }
-            free(p);
+            if (st != ENOENT && st != ENOTDIR && !unreadable) {
+                unreadable = p;
+                unreadable_status = st;
+            } else {
+                free(p);
+            }
         }
         int w = snprintf(looked + len, sizeof looked - len, "%s%s", i ? ", " : "", dirs.items[i]);
         if (w > 0 && (size_t)w < sizeof looked - len)
@@ -1401,9 +1523,21 @@ char *fs_preset_find(const char *name)
     list_free(&dirs);
     char *path = find_by_name(name);
     fs_error_clear();
-    if (path)
+    if (path) {
+        free(unreadable);
         return path;
-    fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: no such file, and not on the preset path (%s)", name, looked);
+    }
+    /* a name that exists here or on the path but cannot be read (a directory, a symlink loop, a
+     * device, a FIFO) says why, rather than "no such file" */
+    if (status != ENOENT)
+        fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: %s, and not on the preset path (%s)", name,
+                 status_text(status), looked);
+    else if (unreadable)
+        fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: %s: %s", name, unreadable, status_text(unreadable_status));
+    else
+        fs_error(FS_ERR_NOINPUT, "%s: cannot open preset: no such file, and not on the preset path (%s)", name,
+                 looked);
+    free(unreadable);
     return NULL;
 }
 

@@ -9,8 +9,14 @@
 /* Parses the preset file at path over cfg (which the caller set to fs_config_default()). Unknown
  * sections and keys, bad types, values out of range and disallowed words are errors reported as
  *   FILE:LINE: [section] key: expected ..., got '...'
- * Returns 0, or -1 with fs_error(FS_ERR_NOINPUT) for a missing file or FS_ERR_DATA for bad content. */
+ * Only a regular file of at most 1 MiB is read (a FIFO or a device is refused without blocking).
+ * Returns 0, or -1 with fs_error(FS_ERR_NOINPUT) for a missing, unreadable or irregular file or
+ * FS_ERR_DATA for bad content or a file over the cap. */
 int fs_preset_load(const char *path, fs_config *cfg);
+
+/* The text of the preset file at path (for its hash): a regular file of at most 1 MiB, as
+ * fs_preset_load reads it. Returns a malloc'd string, or NULL with fs_error. */
+char *fs_preset_read_text(const char *path);
 
 /* Parses a preset from memory; `origin` names it in messages. */
 int fs_preset_load_string(const char *text, const char *origin, fs_config *cfg);

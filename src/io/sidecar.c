@@ -3,6 +3,7 @@
 
 #include "config.h"
 
+#include <errno.h>
 #include <stdbool.h>
 #include <string.h>
 
@@ -95,7 +96,7 @@ static fs_json *map_entry(const fs_sidecar_map *m, const fs_config *cfg, const f
 
 int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_text, const fs_stats *stats,
                      const fs_maps *maps, const char *target, const fs_sidecar_map *list, int n_maps,
-                     const fs_sidecar_frames *frames, double wall_seconds)
+                     const fs_sidecar_frames *frames, const char *const *files, int n_files, double wall_seconds)
 {
     fs_json *root = fs_json_object();
     fs_json_set(root, "generator", fs_json_string("fissure"));
@@ -157,10 +158,24 @@ int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_
         fs_json_set(root, "frames", jf);
     }
 
+    fs_json *jfiles = fs_json_array();
+    for (int i = 0; i < n_files; i++) {
+        if (!fs_json_valid_utf8(files[i])) {
+            fs_json_free(jfiles);
+            fs_json_free(root);
+            fs_error(FS_ERR_CANTCREAT, "%s: the sidecar cannot list a file name that is not UTF-8", files[i]);
+            return -1;
+        }
+        fs_json_append(jfiles, fs_json_string(files[i]));
+    }
+    fs_json_set(root, "files", jfiles);
+
+    errno = 0;
     int rc = fs_json_write(root, path, (fs_json_format){2, 10});
+    int err = errno;
     fs_json_free(root);
     if (rc != 0) {
-        fs_error(FS_ERR_IO, "%s: cannot write the sidecar", path);
+        fs_error(FS_ERR_IO, "%s: cannot write the sidecar: %s", path, strerror(err ? err : EIO));
         return -1;
     }
     return 0;

@@ -33,10 +33,11 @@ typedef struct {
 /* Writes the sidecar to path: version, preset name and hash, seed, every resolved parameter,
  * statistics, the engine target (--target) and per file its colour space, bit depth, channels and
  * their meaning, engine usage, normal convention, height scale and tileability (never for the
- * perspective preview), and the time-lapse frames if frames is not NULL. preset_text is the
- * preset file's content (hashed), or NULL. Returns 0 or -1. */
+ * perspective preview), the time-lapse frames if frames is not NULL, and `files`: every file of
+ * the run but the sidecar (io/output.h's fs_output_names), which is what makes a whole set.
+ * preset_text is the preset file's content (hashed), or NULL. Returns 0 or -1. */
 int fs_sidecar_write(const char *path, const fs_config *cfg, const char *preset_text, const fs_stats *stats,
                      const fs_maps *maps, const char *target, const fs_sidecar_map *list, int n_maps,
-                     const fs_sidecar_frames *frames, double wall_seconds);
+                     const fs_sidecar_frames *frames, const char *const *files, int n_files, double wall_seconds);
 
 #endif

@@ -12,7 +12,6 @@
 #include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
-#include "base/threads.h"
 
 _Static_assert(sizeof(int) == sizeof(int32_t), "the int interface of CHOLMOD reads our int32_t arrays");
 
@@ -364,21 +363,23 @@ void fs_cholesky_free(fs_cholesky *c)
 
 /* design: CHOLMOD's supernodal factorization and solves spend their time in the BLAS, which is
  * whatever libblas.so.3 the system provides (fissure links CHOLMOD only). OpenBLAS, Debian's usual
- * one, runs its own thread pool, sized when it loads (before main) from OPENBLAS_NUM_THREADS or
- * OMP_NUM_THREADS, or the processors; setting those variables from main is too late. Its run-time
- * entry openblas_set_num_threads resizes the pool, so when a thread budget was given (-j; base/
- * threads.h) it is looked up in the process (dlsym, no link-time dependency) and called with the
- * budget whenever that differs from what it was last given. Without -j, and with another BLAS, the
- * BLAS keeps its own setting (its environment variables, else the processors). The
- * factor does not depend on the count: OpenBLAS splits its kernels' output blocks among threads,
- * each block summed in one order (tests/cli_threads.sh compares -j 1 and -j 2 byte for byte). */
+ * one, runs its kernels on a pool of threads, and its threaded paths round differently from its
+ * one-thread path and from each other: with OpenBLAS 0.3.21, dpotrf, dgemm, dtrsm and dgemv give
+ * other bits at 2, 3 or 4 threads than at 1 on matrices from about 50 rows, the size of the
+ * supernodes of a few thousand elements. That made the fracture sequence, and every map, depend on
+ * -j and on the processors (mud-springs, seed 11, 1500 elements: 2934 fractures at -j 1, 2933 at
+ * -j 2). The rounding of a kernel cannot be made independent of its split from outside the BLAS,
+ * so the BLAS always runs on one thread: its pool is sized when it loads (OPENBLAS_NUM_THREADS,
+ * OMP_NUM_THREADS, else the processors), and its run-time entry openblas_set_num_threads, looked up
+ * in the process (dlsym, no link-time dependency), is called with 1 before every analysis and
+ * factorization, whatever -j and the environment say. It costs next to nothing on the presets (mud:
+ * 8.6 to 11 s with one BLAS thread or two on two cores: the supernodes are small); the thread budget
+ * goes to the work that splits without changing a bit (sampling, Delaunay blocks, the rasteriser).
+ * Another BLAS is left as it is configured. */
 static void apply_blas_threads(void)
 {
-    if (!fs_threads_given())
-        return;
     static bool looked_up;
     static void (*set_threads)(int);
-    static int applied;
     if (!looked_up) {
         looked_up = true;
         void *self = dlopen(NULL, RTLD_LAZY);
@@ -386,14 +387,11 @@ static void apply_blas_threads(void)
             *(void **)(&set_threads) = dlsym(self, "openblas_set_num_threads");
             dlclose(self);
         }
-        fs_debug("cholmod: BLAS threads %s", set_threads ? "set through openblas_set_num_threads"
-                                                         : "left to the BLAS (not OpenBLAS)");
+        fs_debug("cholmod: BLAS %s", set_threads ? "on one thread (openblas_set_num_threads)"
+                                                 : "left as configured (not OpenBLAS)");
     }
-    int n = fs_threads();
-    if (set_threads && n != applied) {
-        set_threads(n);
-        applied = n;
-    }
+    if (set_threads)
+        set_threads(1);
 }
 
 fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a)
@@ -460,6 +458,7 @@ static int restore_symbolic(fs_cholesky *c)
 int fs_cholesky_factorize(fs_cholesky *c, const fs_sparse_matrix *a)
 {
     FS_ASSERT(a->n == c->n && fs_sparse_matrix_nnz(a) == c->nnz);
+    apply_blas_threads();
     c->valid = 0;
     cholmod_message[0] = '\0';
     if (c->stale && restore_symbolic(c) != 0)
