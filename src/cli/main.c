@@ -377,20 +377,6 @@ static int load_config(const char *arg, const options *o, fs_config *cfg, char *
     return fs_preset_validate(cfg, *preset_path);
 }
 
-/* The directory of a file path (malloc'd: "." for a bare name, "/" at the root), and in *file the
- * file name in it. */
-static char *dir_of(const char *path, const char **file)
-{
-    char *dir = fs_strdup(path);
-    char *slash = strrchr(dir, '/');
-    *file = slash ? path + (slash - dir) + 1 : path;
-    if (!slash)
-        strcpy(dir, ".");
-    else
-        slash[slash == dir ? 1 : 0] = '\0';
-    return dir;
-}
-
 /* Checks, before the run, that the outputs can be created: the output directory (or the ancestor
  * it would be created in) and the directories of the --mesh and --asset files are writable
  * directories. */
@@ -403,7 +389,7 @@ static int check_outputs(const options *o, const char *name)
         if (!beside[i])
             continue;
         const char *file;
-        char *dir = dir_of(beside[i], &file);
+        char *dir = fs_output_dir_of(beside[i], &file);
         int rc = fs_output_check(dir, STAGED_NAME_BYTES(strlen(file)));
         free(dir);
         if (rc < 0)

@@ -19,19 +19,6 @@
 #include "io/gltf.h"
 #include "io/obj.h"
 
-/* The directory part of path ("." when none) and its last component. */
-static char *dir_of(const char *path, const char **file)
-{
-    char *dir = fs_strdup(path);
-    char *slash = strrchr(dir, '/');
-    *file = slash ? path + (slash - dir) + 1 : path;
-    if (!slash)
-        strcpy(dir, ".");
-    else
-        slash[slash == dir ? 1 : 0] = '\0';
-    return dir;
-}
-
 /* The path from directory `from` to directory `to` (both existing), "" when they are the same
  * directory, else ending in '/', so that a file name appended to it names the file in `to`. NULL
  * with fs_error when either cannot be resolved. */
@@ -151,7 +138,7 @@ static int write_mtl(const char *path, const fs_asset_inputs *in, const char *re
  * from that directory to the maps' (caller frees). NULL with fs_error on failure. */
 static fs_output *begin_beside(const char *path, const fs_asset_inputs *in, const char **file, char **rel)
 {
-    char *dir = dir_of(path, file);
+    char *dir = fs_output_dir_of(path, file);
     fs_output *out = fs_output_begin(dir);
     *rel = out ? relative_dir(dir, in->map_dir) : NULL;
     free(dir);
@@ -263,7 +250,7 @@ static int add_entry(const fs_asset_inputs *in, const char *path, const char *ex
                      char *shown)
 {
     const char *file;
-    char *dir = dir_of(path, &file);
+    char *dir = fs_output_dir_of(path, &file);
     char *rel = relative_dir(in->map_dir, dir);
     free(dir);
     if (!rel)

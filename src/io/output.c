@@ -157,6 +157,18 @@ int fs_output_check(const char *dir, size_t longest_name)
     return rc;
 }
 
+char *fs_output_dir_of(const char *path, const char **file)
+{
+    char *dir = fs_strdup(path);
+    char *slash = strrchr(dir, '/');
+    *file = slash ? path + (slash - dir) + 1 : path;
+    if (!slash)
+        strcpy(dir, ".");
+    else
+        slash[slash == dir ? 1 : 0] = '\0';
+    return dir;
+}
+
 fs_output *fs_output_begin(const char *dir)
 {
     if (!dir || !*dir)

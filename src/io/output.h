@@ -14,6 +14,10 @@ typedef struct fs_output fs_output;
  * longest_name bytes. Creates nothing. Returns 0, or -1 with fs_error(FS_ERR_CANTCREAT). */
 int fs_output_check(const char *dir, size_t longest_name);
 
+/* The directory of a file path (malloc'd: "." for a bare name, "/" at the root), and in *file the
+ * file name in it (pointing into path). */
+char *fs_output_dir_of(const char *path, const char **file);
+
 /* Starts an output set in directory dir (created if missing, with parents). Returns NULL with
  * fs_error(FS_ERR_CANTCREAT) if the directory cannot be created or written. */
 fs_output *fs_output_begin(const char *dir);
