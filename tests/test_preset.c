@@ -319,7 +319,7 @@ static void test_errors(void)
     static const error_case cases[] = {
         {"[preset]\nname = a\n[colour]\nx = 1\n",
          "t.ini:3: unknown section [colour]: expected one of: preset, domain, mesh, material, growth, shrink, "
-         "fracture, time, render, voronoi, solver, wedge, springs, tet"},
+         "fracture, time, render, voronoi, solver, wedge, springs, tet, shell"},
         {"[mesh]\n\nelement = 100\n",
          "t.ini:3: unknown key [mesh] element: expected one of: elements, min_size, lattice, relax_iterations, "
          "radius_jitter, refine_vm, refine_vm_rounds, smooth_radius, smooth_iterations"},
@@ -330,7 +330,7 @@ static void test_errors(void)
         {"[material]\nthickness_final = 0\n",
          "t.ini:2: [material] thickness_final: expected none or a number > 0 (cm), got '0'"},
         {"[domain]\nwidth = 2e6\n", "t.ini:2: [domain] width: expected a number in (0, 1e+06] (cm), got '2e6'"},
-        {"[domain]\ntype = torus\n", "t.ini:2: [domain] type: expected plane, cylinder or sphere, got 'torus'"},
+        {"[domain]\ntype = torus\n", "t.ini:2: [domain] type: expected plane, cylinder, sphere or mesh, got 'torus'"},
         {"[domain]\nperiodic = z\n", "t.ini:2: [domain] periodic: expected none, x, y or xy, got 'z'"},
         {"[mesh]\nelements = 1000.5\n", "t.ini:2: [mesh] elements: expected an integer in 16..20000000, got '1000.5'"},
         {"[mesh]\nelements = 8\n", "t.ini:2: [mesh] elements: expected an integer in 16..20000000, got '8'"},
@@ -441,7 +441,7 @@ static void test_set(void)
         {"a.b.c=5", FS_ERR_USAGE, "--set: expected SECTION.KEY=VALUE, got 'a.b.c=5'"},
         {"meshes.elements=5", FS_ERR_USAGE,
          "--set meshes.elements: unknown section [meshes]: expected one of: preset, domain, mesh, material, growth, "
-         "shrink, fracture, time, render, voronoi, solver, wedge, springs, tet"},
+         "shrink, fracture, time, render, voronoi, solver, wedge, springs, tet, shell"},
         {"time.stop=5", FS_ERR_USAGE, "--set time.stop: unknown key [time] stop: expected one of: end, min_step"},
         {"mesh.elements=lots", FS_ERR_DATA, "--set mesh.elements: expected an integer in 16..20000000, got 'lots'"},
         {"render.normal=up", FS_ERR_DATA, "--set render.normal: expected opengl or directx, got 'up'"},

@@ -114,7 +114,7 @@ static void print_help(FILE *out)
           "                          implies --target gltf\n"
           "      --frames N          also write N time-lapse frames NAME_frame_0001_MAP.png ... of the\n"
           "                          crack growth (maps: those of --maps that are texture maps, else\n"
-          "                          basecolor and crackmask; springs and wedge models only)\n"
+          "                          basecolor and crackmask; not the voronoi model)\n"
           "  -j, --threads N         run parallel work on at most N threads, 1 to 256, or 0 for one\n"
           "                          per processor (default); the results do not depend on N\n"
           "      --job FILE:N        run job N (from 1) of the jobs file FILE, one job a line:\n"
@@ -462,7 +462,12 @@ static int write_frame(void *ctx, int32_t k, int32_t count, double t, const fs_s
                 (long long)stats->fractures);
     bool kinds[FS_MAP_COUNT] = {false};
     fs_outputs built;
-    int rc = fs_outputs_build(surface, cfg, kinds, false, &built);
+    fs_config frame_cfg = *cfg; /* a mesh domain's cm per texture unit are known once it is read */
+    if (frame_cfg.domain.type == FS_DOMAIN_MESH) {
+        frame_cfg.domain.width = stats->extent_u;
+        frame_cfg.domain.height = stats->extent_v;
+    }
+    int rc = fs_outputs_build(surface, &frame_cfg, kinds, false, &built);
     char stem[560];
     snprintf(stem, sizeof stem, "%s_frame_%04d", fw->name, (int)k);
     fs_target_inputs in = {.maps = &built.maps, .height = &built.maps.height, .height_ext = "png",
@@ -571,6 +576,8 @@ static int run(const char *preset_arg, const options *o)
     fs_sim_frames frames = {o->frames, write_frame, &fw};
     int rc = fs_sim_run_frames(&cfg, o->frames > 0 ? &frames : NULL, &res);
     if (rc == 0) {
+        if (cfg.domain.type == FS_DOMAIN_MESH)
+            cfg.domain = res.mesh.domain; /* a mesh domain's texture size is known once it is read */
         fs_progress("render", -1, "%dx%d, %d triangles", cfg.render.width, cfg.render.height,
                     (int)res.surface.n_tris);
         rc = fs_outputs_build(&res.surface, &cfg, o->maps, o->exr, &built);

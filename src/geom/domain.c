@@ -22,13 +22,13 @@ void fs_domain_normalize(fs_domain *d)
 {
     if (d->type == FS_DOMAIN_CYLINDER)
         d->periodic_x = true;
-    else if (d->type == FS_DOMAIN_SPHERE)
+    else if (d->type == FS_DOMAIN_SPHERE || d->type == FS_DOMAIN_MESH)
         d->periodic_x = d->periodic_y = false;
 }
 
 double fs_domain_extent_x(const fs_domain *d)
 {
-    return d->type == FS_DOMAIN_PLANE ? d->width : 2.0 * FS_PI * d->radius;
+    return d->type == FS_DOMAIN_PLANE || d->type == FS_DOMAIN_MESH ? d->width : 2.0 * FS_PI * d->radius;
 }
 
 double fs_domain_extent_y(const fs_domain *d)
@@ -40,6 +40,7 @@ double fs_domain_area(const fs_domain *d)
 {
     switch (d->type) {
     case FS_DOMAIN_PLANE:
+    case FS_DOMAIN_MESH:
         return d->width * d->height;
     case FS_DOMAIN_CYLINDER:
         return 2.0 * FS_PI * d->radius * d->height;
@@ -98,6 +99,7 @@ void fs_domain_embed(const fs_domain *d, const double *p, double *world)
 {
     switch (d->type) {
     case FS_DOMAIN_PLANE:
+    case FS_DOMAIN_MESH:
         world[0] = p[0];
         world[1] = p[1];
         world[2] = 0.0;
@@ -121,6 +123,7 @@ void fs_domain_normal(const fs_domain *d, const double *p, double *n)
 {
     switch (d->type) {
     case FS_DOMAIN_PLANE:
+    case FS_DOMAIN_MESH:
         n[0] = 0.0;
         n[1] = 0.0;
         n[2] = 1.0;
@@ -152,6 +155,7 @@ void fs_domain_to_uv(const fs_domain *d, const double *p, double *uv)
     switch (d->type) {
     case FS_DOMAIN_PLANE:
     case FS_DOMAIN_CYLINDER:
+    case FS_DOMAIN_MESH:
         uv[0] = p[0] / fs_domain_extent_x(d);
         uv[1] = p[1] / fs_domain_extent_y(d);
         return;
@@ -175,6 +179,7 @@ void fs_domain_from_uv(const fs_domain *d, const double *uv, double *p)
     switch (d->type) {
     case FS_DOMAIN_PLANE:
     case FS_DOMAIN_CYLINDER:
+    case FS_DOMAIN_MESH:
         p[0] = uv[0] * fs_domain_extent_x(d);
         p[1] = uv[1] * fs_domain_extent_y(d);
         p[2] = 0.0;
@@ -190,9 +195,15 @@ void fs_domain_from_uv(const fs_domain *d, const double *uv, double *p)
     }
 }
 
-bool fs_domain_wraps_u(const fs_domain *d) { return d->type != FS_DOMAIN_PLANE || d->periodic_x; }
+bool fs_domain_wraps_u(const fs_domain *d)
+{
+    return d->type == FS_DOMAIN_CYLINDER || d->type == FS_DOMAIN_SPHERE || (d->type == FS_DOMAIN_PLANE && d->periodic_x);
+}
 
-bool fs_domain_wraps_v(const fs_domain *d) { return d->type != FS_DOMAIN_SPHERE && d->periodic_y; }
+bool fs_domain_wraps_v(const fs_domain *d)
+{
+    return (d->type == FS_DOMAIN_PLANE || d->type == FS_DOMAIN_CYLINDER) && d->periodic_y;
+}
 
 const char *fs_domain_type_name(fs_domain_type t)
 {
@@ -203,6 +214,8 @@ const char *fs_domain_type_name(fs_domain_type t)
         return "cylinder";
     case FS_DOMAIN_SPHERE:
         return "sphere";
+    case FS_DOMAIN_MESH:
+        return "mesh";
     }
     return "unknown";
 }

@@ -4,18 +4,23 @@
 
 #include <stdbool.h>
 
-typedef enum { FS_DOMAIN_PLANE = 0, FS_DOMAIN_CYLINDER = 1, FS_DOMAIN_SPHERE = 2 } fs_domain_type;
+typedef enum { FS_DOMAIN_PLANE = 0, FS_DOMAIN_CYLINDER = 1, FS_DOMAIN_SPHERE = 2, FS_DOMAIN_MESH = 3 } fs_domain_type;
 
 /* design: every point lives in "domain coordinates", three doubles:
  *   plane     (x, y, 0)        x in [0, width), y in [0, height)              (cm)
  *   cylinder  (s, z, 0)        s = radius * angle in [0, 2 pi radius), z in [0, height)  (unwrapped, cm)
  *   sphere    (x, y, z)        a point on the sphere of the given radius, centred at the origin (cm)
  * Plane and cylinder are therefore both rectangles [0, period_x) x [0, period_y) in the (first two)
- * coordinates; the cylinder is always periodic in s. */
+ * coordinates; the cylinder is always periodic in s.
+ *   mesh      (x, y, z)        a vertex of a loaded triangle mesh (geom/uvmesh.h), in space (cm)
+ * A mesh carries its texture coordinates per triangle corner (its own UV layout), so its points have
+ * no texture point of their own: for rendering, texture space is the rectangle width x height (cm
+ * per unit of u and v, set from the mesh's area when it is loaded) and the functions below treat it
+ * as a non-periodic plane of that size (embedding, normal and texture maps of the flat layout). */
 typedef struct {
     fs_domain_type type;
-    double width;     /* plane: extent in x (cm) */
-    double height;    /* plane, cylinder: extent in y / along the axis (cm) */
+    double width;     /* plane: extent in x (cm); mesh: cm per unit of u */
+    double height;    /* plane, cylinder: extent in y / along the axis (cm); mesh: cm per unit of v */
     double radius;    /* cylinder, sphere (cm) */
     bool periodic_x;  /* plane: wraps in x; cylinder: always true (set by fs_domain_normalize) */
     bool periodic_y;  /* plane: wraps in y; cylinder: wraps along the axis */

@@ -91,6 +91,8 @@ static int check_domain(const char *what, const fs_domain *d)
         if (!positive_finite(d->radius))
             return bad_length(what, "radius", d->radius);
         return 0;
+    case FS_DOMAIN_MESH:
+        break; /* a mesh is loaded, not sampled */
     }
     fs_error(FS_ERR_DATA, "%s: unknown domain type %d", what, (int)d->type);
     return -1;

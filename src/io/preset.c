@@ -60,9 +60,9 @@ typedef struct {
 
 static const char *const section_names[] = {"preset", "domain", "mesh", "material", "growth",
                                             "shrink", "fracture", "time", "render", "voronoi", "solver",
-                                            "wedge", "springs", "tet", NULL};
+                                            "wedge", "springs", "tet", "shell", NULL};
 static const char *const model_words[] = {"voronoi", "springs", "wedge", "shell", "tet", NULL};
-static const char *const domain_words[] = {"plane", "cylinder", "sphere", NULL};
+static const char *const domain_words[] = {"plane", "cylinder", "sphere", "mesh", NULL};
 static const char *const periodic_words[] = {"none", "x", "y", "xy", NULL};
 static const char *const lattice_words[] = {"random", "hex", NULL};
 static const char *const growth_words[] = {"none", "planar", "cylinder", "sphere", NULL};
@@ -86,6 +86,7 @@ static const key_def key_table[] = {
     {"domain", "height", KEY_REAL, OFF(domain.height), 0, 1e6, GT | LE, NULL, "cm"},
     {"domain", "radius", KEY_REAL, OFF(domain.radius), 0, 1e6, GT | LE, NULL, "cm"},
     {"domain", "periodic", KEY_PERIODIC, 0, 0, 0, 0, periodic_words, NULL},
+    {"domain", "file", KEY_PATH, OFF(domain_file), 0, 0, 0, NULL, NULL},
 
     {"mesh", "elements", KEY_INT, OFF(mesh.elements), 16, 20000000, GE | LE, NULL, NULL},
     {"mesh", "min_size", KEY_REAL, OFF(mesh.min_size), 0, 0, GT, NULL, "cm"},
@@ -169,6 +170,12 @@ static const key_def key_table[] = {
     {"tet", "snap_angle", KEY_REAL, OFF(tet.snap_angle), 0, 30, GE | LE, NULL, "degrees"},
     {"tet", "bond", KEY_REAL, OFF(tet.bond), 0, 0, GE, NULL, "kPa"},
     {"tet", "max_events", KEY_INT, OFF(tet.max_events), 0, 2000000000, GE | LE, NULL, NULL},
+    {"shell", "bond", KEY_REAL, OFF(shell.bond), 0, 1e6, GE | LE, NULL, NULL},
+    {"shell", "yield", KEY_REAL, OFF(shell.yield), 0, 0, GE, NULL, "kPa"},
+    {"shell", "hardening", KEY_REAL, OFF(shell.hardening), 0, 0, GE, NULL, NULL},
+    {"shell", "budge", KEY_REAL, OFF(shell.budge), 0, 0.45, GE | LE, NULL, NULL},
+    {"shell", "gap_scale", KEY_REAL, OFF(shell.gap_scale), 1, 1e6, GE | LE, NULL, NULL},
+    {"shell", "max_step", KEY_REAL, OFF(shell.max_step), 0, 1, GT | LE, NULL, NULL},
 };
 
 #define N_KEYS ((int)(sizeof key_table / sizeof key_table[0]))
@@ -840,8 +847,29 @@ static int cross_check(const fs_config *cfg, const char *origin, const int *line
     int i_type = key_index("domain", "type"), i_periodic = key_index("domain", "periodic");
     int i_radius = key_index("domain", "radius"), i_width = key_index("domain", "width");
     int i_height = key_index("domain", "height");
-    FS_ASSERT((unsigned)d->type <= FS_DOMAIN_SPHERE && (unsigned)cfg->growth.type <= FS_GROWTH_SPHERE);
+    FS_ASSERT((unsigned)d->type <= FS_DOMAIN_MESH && (unsigned)cfg->growth.type <= FS_GROWTH_SPHERE);
     const char *dname = domain_words[d->type];
+
+    int i_file = key_index("domain", "file"), i_model = key_index("preset", "model");
+    if (d->type == FS_DOMAIN_MESH) {
+        if (!cfg->domain_file[0])
+            return cross_fail(origin, lines, i_file, i_type, "expected the path of a UV-mapped OBJ mesh for a mesh "
+                              "domain, got ''");
+        if (cfg->preset.model != FS_MODEL_SHELL) {
+            if (pick(lines, i_model, i_type) == i_model)
+                return cross_fail(origin, lines, i_model, -1, "expected shell for a mesh domain, got '%s'",
+                                  fs_model_name(cfg->preset.model));
+            return cross_fail(origin, lines, i_type, -1, "expected plane, cylinder or sphere for the %s model, got "
+                              "'mesh'", fs_model_name(cfg->preset.model));
+        }
+        if (d->periodic_x || d->periodic_y)
+            return cross_fail(origin, lines, i_periodic, -1, "expected none for a mesh domain, got '%s'",
+                              periodic_words[(d->periodic_x ? 1 : 0) + (d->periodic_y ? 2 : 0)]);
+        if (cfg->growth.type != FS_GROWTH_NONE)
+            return cross_fail(origin, lines, key_index("growth", "type"), i_type, "expected none for a mesh domain "
+                              "(shrinkage drives it), got '%s'", fs_growth_type_name(cfg->growth.type));
+        goto time_checks;
+    }
 
     if (d->type != FS_DOMAIN_PLANE && !(d->radius > 0 && d->radius <= 1e6))
         return cross_fail(origin, lines, i_radius, i_type, "expected a number in (0, 1e+06] (cm) for a %s, got '%g'",
@@ -890,6 +918,7 @@ static int cross_check(const fs_config *cfg, const char *origin, const int *line
                           extent, cfg->mesh.min_size);
     }
 
+time_checks:;
     int i_end = key_index("time", "end"), i_min_step = key_index("time", "min_step");
     if (!(cfg->time.min_step < cfg->time.end)) {
         if (pick(lines, i_min_step, i_end) == i_min_step)

@@ -34,6 +34,7 @@ fs_model_setup fs_model_setup_default(void)
     s.springs = fs_springs_params_default();
     s.wedge = fs_wedge_params_default();
     s.tet = fs_tet_params_default();
+    s.shell = fs_shell_params_default();
     return s;
 }
 
@@ -48,10 +49,10 @@ int fs_model_init(fs_model *m, fs_mesh *mesh, const fs_model_setup *setup)
     case FS_MODEL_SPRINGS: return (m->state.springs = fs_springs_create(mesh, setup)) ? 0 : -1;
     case FS_MODEL_WEDGE: return (m->state.wedge = fs_wedge_create(mesh, setup)) ? 0 : -1;
     case FS_MODEL_TET: return (m->state.tet = fs_tet_create(mesh, setup)) ? 0 : -1;
-    case FS_MODEL_SHELL: break;
+    case FS_MODEL_SHELL: return (m->state.shell = fs_shell_create(mesh, setup)) ? 0 : -1;
     }
-    fs_error(FS_ERR_DATA, "[preset] model: the %s model is not available in this build; expected voronoi, springs, "
-             "wedge or tet", fs_model_name(setup->kind));
+    fs_error(FS_ERR_DATA, "[preset] model: unknown model kind %d; expected voronoi, springs, wedge, tet or shell",
+             (int)setup->kind);
     return -1;
 }
 
@@ -61,6 +62,7 @@ int fs_model_advance(fs_model *m, double t)
     case FS_MODEL_SPRINGS: return fs_springs_advance(m->state.springs, t);
     case FS_MODEL_WEDGE: return fs_wedge_advance(m->state.wedge, t);
     case FS_MODEL_TET: return fs_tet_advance(m->state.tet, t);
+    case FS_MODEL_SHELL: return fs_shell_advance(m->state.shell, t);
     default: return 0;
     }
 }
@@ -72,6 +74,7 @@ int fs_model_surface(const fs_model *m, fs_surface *out)
     case FS_MODEL_SPRINGS: return fs_springs_surface(m->state.springs, out);
     case FS_MODEL_WEDGE: return fs_wedge_surface(m->state.wedge, out);
     case FS_MODEL_TET: return fs_tet_surface(m->state.tet, out);
+    case FS_MODEL_SHELL: return fs_shell_surface(m->state.shell, out);
     default: FS_ASSERT(!"fs_model_surface of a model that was not built"); return -1;
     }
 }
@@ -90,6 +93,7 @@ fs_model_info fs_model_stats(const fs_model *m)
     case FS_MODEL_SPRINGS: return fs_springs_info(m->state.springs);
     case FS_MODEL_WEDGE: return fs_wedge_info(m->state.wedge);
     case FS_MODEL_TET: return fs_tet_info(m->state.tet);
+    case FS_MODEL_SHELL: return fs_shell_info(m->state.shell);
     default: return (fs_model_info){0, 0.0};
     }
 }
@@ -100,6 +104,7 @@ void fs_model_report(const fs_model *m)
     case FS_MODEL_SPRINGS: fs_springs_report(m->state.springs); break;
     case FS_MODEL_WEDGE: fs_wedge_report(m->state.wedge); break;
     case FS_MODEL_TET: fs_tet_report(m->state.tet); break;
+    case FS_MODEL_SHELL: fs_shell_report(m->state.shell); break;
     default: break;
     }
 }
@@ -110,6 +115,7 @@ void fs_model_free(fs_model *m)
     case FS_MODEL_SPRINGS: fs_springs_destroy(m->state.springs); break;
     case FS_MODEL_WEDGE: fs_wedge_destroy(m->state.wedge); break;
     case FS_MODEL_TET: fs_tet_destroy(m->state.tet); break;
+    case FS_MODEL_SHELL: fs_shell_destroy(m->state.shell); break;
     default: break;
     }
     memset(m, 0, sizeof *m);

@@ -9,6 +9,7 @@
 #include "geom/mesh.h"
 #include "geom/surface.h"
 #include "model/params.h"
+#include "model/shell/shell.h"
 #include "model/springs/springs.h"
 #include "model/tet/tet.h"
 #include "model/voronoi.h"
@@ -84,6 +85,10 @@ struct fs_model_setup {
     fs_springs_params springs;
     fs_wedge_params wedge;
     fs_tet_params tet;
+    fs_shell_params shell;
+    const double *corner_uv;      /* mesh domain: 6 per triangle of the mesh given to fs_model_init, the
+                                     texture coordinates of its corners (the UV layout the maps are
+                                     rendered into; borrowed); NULL on the other domains */
 };
 typedef struct fs_model_setup fs_model_setup;
 
@@ -99,6 +104,7 @@ typedef struct {
         fs_springs *springs;
         fs_wedge_model *wedge;
         fs_tet *tet;
+        fs_shell *shell;
     } state;                      /* the kind's state; voronoi has none */
 } fs_model;
 

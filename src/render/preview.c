@@ -111,6 +111,7 @@ static void texture_frame(const fs_domain *d, double u, double v, double *frame)
     double lon = 2.0 * FS_PI * u, lat = FS_PI * v - 0.5 * FS_PI;
     switch (d->type) {
     case FS_DOMAIN_PLANE:
+    case FS_DOMAIN_MESH:
         frame[0] = 1.0;
         frame[4] = 1.0;
         return;
@@ -133,7 +134,8 @@ static void texture_frame(const fs_domain *d, double u, double v, double *frame)
 static double height_above(const fs_domain *d, const double *p)
 {
     switch (d->type) {
-    case FS_DOMAIN_PLANE: return p[2];
+    case FS_DOMAIN_PLANE:
+    case FS_DOMAIN_MESH: return p[2];
     case FS_DOMAIN_CYLINDER: return hypot(p[0], p[1]) - d->radius;
     case FS_DOMAIN_SPHERE: return fs_norm3(p) - d->radius;
     }
@@ -404,6 +406,7 @@ int fs_render_preview(const fs_surface *rm, const fs_domain *dom, const fs_rende
     double el = 0.0, az = 0.0, forward[3] = {0.0, 0.0, 0.0};
     switch (d.type) {
     case FS_DOMAIN_PLANE:
+    case FS_DOMAIN_MESH: /* the texture's layout, flat */
         add_slab(&body, &l, edges, n_edges, &d, fmax(2.0 * h_max, 0.04 * fmin(d.width, d.height)), body_tint);
         cam.up[2] = 1.0;
         forward[1] = 1.0;

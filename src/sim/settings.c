@@ -24,6 +24,7 @@ fs_config fs_config_default(void)
     c.solver = fs_solver_params_default();
     c.wedge = fs_wedge_params_default();
     c.tet = fs_tet_params_default();
+    c.shell = fs_shell_params_default();
     return c;
 }
 
@@ -43,5 +44,6 @@ fs_model_setup fs_config_model_setup(const fs_config *cfg)
     s.springs = cfg->springs;
     s.wedge = cfg->wedge;
     s.tet = cfg->tet;
+    s.shell = cfg->shell;
     return s;
 }

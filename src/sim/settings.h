@@ -31,6 +31,8 @@ typedef struct {
 typedef struct {
     fs_preset_info preset;
     fs_domain domain;
+    char domain_file[FS_PATH_MAX]; /* [domain] file: the UV-mapped OBJ of a mesh domain, resolved against
+                                      the preset's directory; "" for none */
     fs_mesh_params mesh;
     fs_material material;
     fs_material_files material_files;
@@ -44,6 +46,7 @@ typedef struct {
     fs_solver_params solver;
     fs_wedge_params wedge;
     fs_tet_params tet;
+    fs_shell_params shell;
 } fs_config;
 
 /* Every section at its default: a 10 x 10 cm non-periodic plane, voronoi model, 1000 elements. */

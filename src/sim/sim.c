@@ -2,12 +2,14 @@
 #include "sim/sim.h"
 
 #include <stdbool.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "base/error.h"
 #include "base/log.h"
 #include "geom/delaunay.h"
 #include "geom/sample.h"
+#include "geom/uvmesh.h"
 #include "image/image.h"
 #include "model/model.h"
 
@@ -56,9 +58,11 @@ static void free_maps(fs_model_setup *setup)
 
 /* design: the one time loop of every model (model/model.h). A run without frames is the loop with one
  * frame at time.end that hands its surface to out->surface alone. */
-static int run_model(const fs_config *cfg, const fs_domain *domain, const fs_sim_frames *frames, fs_result *out)
+static int run_model(const fs_config *cfg, const fs_domain *domain, const double *corner_uv,
+                     const fs_sim_frames *frames, fs_result *out)
 {
     fs_model_setup setup = fs_config_model_setup(cfg);
+    setup.corner_uv = corner_uv;
     const fs_material_files *files = &cfg->material_files;
     if (load_map(files->thickness_map, domain, &setup.thickness_map) < 0 ||
         load_map(files->young_map, domain, &setup.young_map) < 0 ||
@@ -104,7 +108,7 @@ int fs_sim_run_frames(const fs_config *cfg, const fs_sim_frames *frames, fs_resu
 {
     memset(out, 0, sizeof *out);
     if (frames && frames->count > 0 && cfg->preset.model == FS_MODEL_VORONOI) {
-        fs_error(FS_ERR_DATA, "time-lapse frames: the voronoi model has no time; expected a springs or wedge "
+        fs_error(FS_ERR_DATA, "time-lapse frames: the voronoi model has no time; expected a springs, wedge, tet or shell "
                  "model");
         return -1;
     }
@@ -115,24 +119,36 @@ int fs_sim_run_frames(const fs_config *cfg, const fs_sim_frames *frames, fs_resu
     bool segmented = frames && frames->count > 0;
     fs_domain domain = cfg->domain;
     fs_domain_normalize(&domain);
-
-    double t0 = fs_seconds();
-    fs_progress("sample", -1, "%d points on the %s", (int)cfg->mesh.elements, fs_domain_type_name(domain.type));
-    fs_points pts = {0};
-    if (sample_points(cfg, &pts) < 0)
-        return -1;
-    double t1 = fs_seconds();
-    fs_debug("sampled %d points in %.2f s", (int)pts.n, t1 - t0);
-
-    fs_progress("mesh", -1, "Delaunay triangulation of %d points", (int)pts.n);
-    int rc = fs_delaunay(&domain, &pts, &out->mesh);
-    fs_points_free(&pts);
-    if (rc < 0)
-        return -1;
+    double *corner_uv = NULL;
+    double t0 = fs_seconds(), t1 = t0;
+    int rc;
+    if (domain.type == FS_DOMAIN_MESH) {
+        /* the user's mesh, checked before anything is simulated */
+        fs_progress("mesh", -1, "reading %s", cfg->domain_file);
+        if (fs_uvmesh_read(cfg->domain_file, &out->mesh, &corner_uv) < 0)
+            return -1;
+        domain = out->mesh.domain;
+        fs_debug("read %d vertices, %d triangles", (int)out->mesh.n_nodes, (int)out->mesh.n_tris);
+    } else {
+        fs_progress("sample", -1, "%d points on the %s", (int)cfg->mesh.elements, fs_domain_type_name(domain.type));
+        fs_points pts = {0};
+        if (sample_points(cfg, &pts) < 0)
+            return -1;
+        t1 = fs_seconds();
+        fs_debug("sampled %d points in %.2f s", (int)pts.n, t1 - t0);
+        fs_progress("mesh", -1, "Delaunay triangulation of %d points", (int)pts.n);
+        rc = fs_delaunay(&domain, &pts, &out->mesh);
+        fs_points_free(&pts);
+        if (rc < 0)
+            return -1;
+    }
     double t2 = fs_seconds();
     fs_debug("meshed %d nodes, %d triangles in %.2f s", (int)out->mesh.n_nodes, (int)out->mesh.n_tris, t2 - t1);
 
-    rc = run_model(cfg, &domain, segmented ? frames : NULL, out);
+    out->stats.extent_u = fs_domain_extent_x(&domain);
+    out->stats.extent_v = fs_domain_extent_y(&domain);
+    rc = run_model(cfg, &domain, corner_uv, segmented ? frames : NULL, out);
+    free(corner_uv);
     double t3 = fs_seconds();
     fs_progress_scale(1.0);
     fs_progress_done();

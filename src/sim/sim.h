@@ -14,6 +14,7 @@ typedef struct {
     int64_t fractures;       /* fracture events */
     double simulated_time;   /* time reached */
     double sample_seconds, mesh_seconds, model_seconds; /* wall time per phase */
+    double extent_u, extent_v; /* cm per unit of texture along u and v (a mesh domain's from its area) */
 } fs_stats;
 
 typedef struct {

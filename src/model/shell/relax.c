@@ -1,0 +1,153 @@
+/* Local relaxation of the shell after cracks: only the nodes near the change move, the rest is held (thesis §5.8). */
+#include "model/shell/internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "base/log.h"
+
+/* design: after a crack opens, only the nodes near it move much: the bond to the surface below
+ * carries the released stress into the ground within a shear-lag length of the crack. So the nodes
+ * within RINGS rings of edges of the changed nodes are relaxed with every other node held (a Newton
+ * system over their DOFs and the energy of the triangles and bonds that depend on them, exact for
+ * them), and the result is accepted when the largest residual force anywhere is below
+ * solver.relax_tolerance of the force a crack releases on one edge (the threshold stress on a mean
+ * edge's cross-section), as the wedge model's per-entry bound; else the region doubles, and past a
+ * quarter of the nodes the whole shell is solved. The cascade of cuts at one time ends with a solve
+ * of the whole shell (shell/fracture.c), which clears what the local ones left. */
+#define RINGS 4
+
+/* The nodes within rings rings of the seeds (BFS over the triangles around each node), seeds first. */
+static int32_t region(const fs_shell *s, const int32_t *seeds, int32_t n_seeds, int rings, int32_t *out, uint8_t *mark)
+{
+    const fs_mesh *m = s->mesh;
+    int32_t n = 0;
+    for (int32_t q = 0; q < n_seeds; q++)
+        if (!mark[seeds[q]]) {
+            mark[seeds[q]] = 1;
+            out[n++] = seeds[q];
+        }
+    int32_t start = 0;
+    for (int r = 0; r < rings; r++) {
+        int32_t end = n;
+        for (int32_t q = start; q < end; q++) {
+            int32_t v = out[q];
+            for (int32_t k = m->ring_start[v]; k < m->ring_start[v + 1]; k++) {
+                int32_t t = m->ring_tri[k];
+                for (int c = 0; c < 3; c++) {
+                    int32_t u = m->tri[3 * (size_t)t + c];
+                    if (!mark[u]) {
+                        mark[u] = 1;
+                        out[n++] = u;
+                    }
+                }
+            }
+        }
+        start = end;
+    }
+    return n;
+}
+
+/* Relaxes the nodes of the region (n nodes, marked) alone. Returns 0 or -1. */
+static int relax_region(fs_shell *s, const int32_t *nodes, int32_t n, const uint8_t *mark)
+{
+    const fs_mesh *m = s->mesh;
+    fs_shell_system sys;
+    memset(&sys, 0, sizeof sys);
+    sys.dof = fs_malloc(3 * (size_t)s->n_nodes * sizeof *sys.dof);
+    for (size_t k = 0; k < 3 * (size_t)s->n_nodes; k++)
+        sys.dof[k] = -1;
+    int32_t nf = 0;
+    for (int32_t q = 0; q < n; q++)
+        for (int k = 0; k < 3; k++)
+            if (s->sys.dof[3 * (size_t)nodes[q] + k] >= 0)
+                sys.dof[3 * (size_t)nodes[q] + k] = nf++;
+    sys.n_free = nf;
+    sys.nodes = nodes;
+    sys.n_nodes = n;
+    /* the triangles with a corner in the region, and their neighbours (whose bending reads the
+     * region's nodes across their edges) */
+    uint8_t *in = fs_calloc((size_t)m->n_tris + 1, 1);
+    int32_t *tris = fs_malloc(((size_t)m->n_tris + 1) * sizeof *tris);
+    int32_t nt = 0;
+    for (int32_t q = 0; q < n; q++) {
+        int32_t v = nodes[q];
+        for (int32_t k = m->ring_start[v]; k < m->ring_start[v + 1]; k++) {
+            int32_t t = m->ring_tri[k];
+            if (!in[t]) {
+                in[t] = 1;
+                tris[nt++] = t;
+            }
+        }
+    }
+    int32_t core = nt;
+    for (int32_t q = 0; q < core; q++)
+        for (int i = 0; i < 3; i++) {
+            int32_t u = m->adj[3 * (size_t)tris[q] + i];
+            if (u >= 0 && !in[u]) {
+                in[u] = 1;
+                tris[nt++] = u;
+            }
+        }
+    sys.tris = tris;
+    sys.n_tris = nt;
+    int rc = nf > 0 ? fs_shell_solve(s, &sys) : 0;
+    sys.tris = NULL;
+    sys.nodes = NULL;
+    fs_shell_system_free(&sys);
+    free(tris);
+    free(in);
+    (void)mark;
+    return rc;
+}
+
+/* The force a crack releases on one edge: the mean threshold stress on a mean edge's cross-section
+ * (MPa cm^2), the scale of the residuals a cut leaves. */
+static double release_force(const fs_shell *s)
+{
+    double sum = 0.0, area = 0.0;
+    for (int32_t t = 0; t < s->n_tris; t++) {
+        sum += s->area0[t] * s->threshold[t] * fs_shell_tri_thickness(s, t);
+        area += s->area0[t];
+    }
+    return area > 0.0 ? sum / area * s->unit : 1.0;
+}
+
+int fs_shell_relax(fs_shell *s, const int32_t *seeds, int32_t n_seeds)
+{
+    double t0 = fs_seconds();
+    if (s->cfg.solver.relax == FS_RELAX_GLOBAL || n_seeds == 0) {
+        int rc = fs_shell_equilibrium(s);
+        s->counters.relax_seconds += fs_seconds() - t0;
+        return rc;
+    }
+    double tol = s->cfg.solver.relax_tolerance * release_force(s);
+    int32_t *nodes = fs_malloc(((size_t)s->n_nodes + 1) * sizeof *nodes);
+    uint8_t *mark = fs_calloc((size_t)s->n_nodes + 1, 1);
+    int rc = 1;
+    for (int rings = RINGS; rc == 1 && rings <= 64; rings *= 2) {
+        memset(mark, 0, (size_t)s->n_nodes);
+        int32_t n = region(s, seeds, n_seeds, rings, nodes, mark);
+        if (4 * n > s->n_nodes)
+            break;
+        if (relax_region(s, nodes, n, mark) < 0) {
+            fs_error_clear(); /* no local equilibrium: the whole shell below */
+            break;
+        }
+        s->counters.local_relaxations++;
+        s->counters.local_nodes += n;
+        if (fs_shell_residual(s) <= tol)
+            rc = 0;
+    }
+    free(nodes);
+    free(mark);
+    if (rc == 1) { /* the change reaches far: the whole shell */
+        s->counters.global_fallbacks++;
+        rc = fs_shell_equilibrium(s);
+    }
+    s->counters.relax_seconds += fs_seconds() - t0;
+    return rc;
+}

@@ -1,0 +1,47 @@
+# The shell model from the command line: meshes a user brings, refused before any simulation when bad.
+. "$top_srcdir/tests/lib.sh"
+
+# mesh_preset OBJ: a shell preset on that mesh, into $tmp/mesh.ini
+mesh_preset() {
+    cat >"$tmp/mesh.ini" <<INI
+[preset]
+name = m
+model = shell
+[domain]
+type = mesh
+file = $1
+[shrink]
+top = 0:0, 1:0.01
+bottom = 0:0, 1:0.01
+INI
+}
+
+# Every bad mesh is refused with exit 65, a message naming the file and its defect, and no output.
+awk 'BEGIN { print "# expect: more than 200000 triangles: the largest mesh taken"; print "v 0 0 0"; print "vt 0 0";
+             for (i = 0; i < 3300; i++) { printf "f"; for (k = 0; k < 64; k++) printf " 1/1"; printf "\n" } }' \
+    >"$tmp/too-large.obj"
+n=0
+for obj in "$top_srcdir"/tests/bad-meshes/*.obj "$tmp/too-large.obj"; do
+    n=$((n + 1))
+    base=$(basename "$obj")
+    expect=$(sed -n '1s/^# expect: //p' "$obj")
+    mesh_preset "$obj"
+    out="$tmp/out-$n"
+    "$FISSURE" -q -o "$out" "$tmp/mesh.ini" >"$tmp/stdout" 2>"$tmp/stderr"
+    status=$?
+    problems=
+    [ "$status" -eq 65 ] || problems="$problems; exit status $status, expected 65"
+    grep -qF "$base" "$tmp/stderr" || problems="$problems; stderr does not name $base"
+    [ -n "$expect" ] && grep -qF -- "$expect" "$tmp/stderr" || problems="$problems; stderr does not say \"$expect\""
+    if [ -e "$out" ] && [ -n "$(ls -A "$out")" ]; then problems="$problems; files were written"; fi
+    if [ -z "$problems" ]; then ok "$base refused: $expect"; else
+        not_ok "$base$problems"; sed 's/^/    stderr: /' "$tmp/stderr" | head -3
+    fi
+done
+if [ "$n" -ge 10 ]; then ok "$n bad meshes checked"; else not_ok "only $n bad meshes, expected 10"; fi
+
+mesh_preset "$tmp/missing.obj"
+expect_status 66 "a missing mesh file exits 66" "$FISSURE" -q -o "$tmp/missing-out" "$tmp/mesh.ini"
+grep -qF "missing.obj: cannot open the mesh" "$tmp/stderr" || not_ok "the missing mesh is named"
+
+finish
