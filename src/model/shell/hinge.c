@@ -4,6 +4,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/vec.h"
+
 /* design: phi = 2 tan(theta / 2) = 2 s / (1 + c) with s = sin theta = e . (n1 x n2) and
  * c = cos theta = n1 . n2, e the unit edge a -> b and n1, n2 the unit normals of the two triangles
  * (Gingold et al. choose 2 tan(theta / 2) so that a sharp fold costs without bound; no arc tangent is
@@ -90,12 +92,8 @@ double fs_shell_hinge_phi(const double x[12], double *grad, double *hess)
         ba[k] = a[k] - b[k];
         bc2[k] = c2[k] - b[k];
     }
-    y[0] = ab[1] * ac1[2] - ab[2] * ac1[1];
-    y[1] = ab[2] * ac1[0] - ab[0] * ac1[2];
-    y[2] = ab[0] * ac1[1] - ab[1] * ac1[0];
-    y[3] = ba[1] * bc2[2] - ba[2] * bc2[1];
-    y[4] = ba[2] * bc2[0] - ba[0] * bc2[2];
-    y[5] = ba[0] * bc2[1] - ba[1] * bc2[0];
+    fs_cross3(y, ab, ac1);
+    fs_cross3(y + 3, ba, bc2);
     y[6] = ab[0], y[7] = ab[1], y[8] = ab[2];
     for (int k = 0; k < 3; k++) {
         r[k] = normalise(y + 3 * k, z + 3 * k);
@@ -103,9 +101,10 @@ double fs_shell_hinge_phi(const double x[12], double *grad, double *hess)
             return NAN;
     }
     const double *n1 = z, *n2 = z + 3, *e = z + 6;
-    double n1xn2[3] = {n1[1] * n2[2] - n1[2] * n2[1], n1[2] * n2[0] - n1[0] * n2[2], n1[0] * n2[1] - n1[1] * n2[0]};
-    double s = e[0] * n1xn2[0] + e[1] * n1xn2[1] + e[2] * n1xn2[2];
-    double c = n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2];
+    double n1xn2[3];
+    fs_cross3(n1xn2, n1, n2);
+    double s = fs_dot3(e, n1xn2);
+    double c = fs_dot3(n1, n2);
     double opc = 1.0 + c;
     if (!(opc > 1e-12))
         return NAN;
@@ -136,8 +135,8 @@ double fs_shell_hinge_phi(const double x[12], double *grad, double *hess)
 
     /* level 3: phi(n1, n2, e) */
     double ds[9], dc[9];
-    ds[0] = n2[1] * e[2] - n2[2] * e[1], ds[1] = n2[2] * e[0] - n2[0] * e[2], ds[2] = n2[0] * e[1] - n2[1] * e[0];
-    ds[3] = e[1] * n1[2] - e[2] * n1[1], ds[4] = e[2] * n1[0] - e[0] * n1[2], ds[5] = e[0] * n1[1] - e[1] * n1[0];
+    fs_cross3(ds, n2, e);
+    fs_cross3(ds + 3, e, n1);
     ds[6] = n1xn2[0], ds[7] = n1xn2[1], ds[8] = n1xn2[2];
     for (int k = 0; k < 3; k++) {
         dc[k] = n2[k];
