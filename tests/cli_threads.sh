@@ -50,8 +50,9 @@ same() {
     [ -z "$differ" ] && ok "$name: -j 1 and -j 2 write the same $n files" \
         || not_ok "$name: -j 1 and -j 2 differ in$differ"
 }
-# family NAME PRESET OPTIONS...: every model family, small, every output (all maps, the preview, the
-# crack graph, the mesh, frames where the model has time) at -j 1 and -j 2, compared byte for byte
+# family NAME PRESET OPTIONS...: every model family (voronoi, springs, wedge split and removal, tet,
+# shell), small, every output (all maps, the preview, the crack graph, the mesh, frames where the
+# model has time) at -j 1 and -j 2, compared byte for byte
 # but for the sidecars' timing fields (tests/compare-outputs.sh). The springs and wedge cases ran
 # into BLAS supernodes large enough for OpenBLAS's threaded kernels, which changed the fracture
 # sequence (mud-springs: 2934 fractures at -j 1, 2933 at -j 2).
@@ -73,6 +74,8 @@ family voronoi-sphere voronoi-sphere --size 128x64 --set mesh.elements=2000 -s 4
 family springs mud-springs --size 256x256 --set mesh.elements=1500 -s 11 --frames 2
 family wedge-split bark-a --size 64x64 --set mesh.elements=1300
 family wedge-remove mud-remove --size 64x64 --set mesh.elements=3000 -s 5 --frames 2
+family tet mud-thick --size 64x64 --set mesh.elements=600 --frames 2
+family shell eggshell --size 128x64 --set mesh.elements=300 --frames 2
 # Without -j the BLAS's and the rasteriser's own settings do not matter either.
 OPENBLAS_NUM_THREADS=2 OMP_NUM_THREADS=2 LP_NUM_THREADS=3 "$FISSURE" -q -o "$tmp/f-springs-env" -n o \
     --mesh "$tmp/f-springs-env/o.obj" --maps all --set render.preview_size=160x120 --size 256x256 \
