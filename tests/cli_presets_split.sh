@@ -8,10 +8,6 @@
 
 STATS="$(dirname "$FISSURE")/tests/crack_stats"
 TEXTURES="$top_srcdir/textures"
-# fractures N from a sidecar
-fractures() { sed -n 's/^ *"fractures": *\([0-9]*\),*$/\1/p' "$1"; }
-# awk_true EXPR: exit 0 if the awk expression is true
-awk_true() { awk "BEGIN { exit !($1) }"; }
 
 # run PRESET SIZE ELEMENTS [--set ...]: runs it into $tmp/PRESET (name x) and checks its outputs.
 run() {

@@ -3,9 +3,6 @@
 . "$top_srcdir/tests/lib.sh"
 EDGES="$(dirname "$FISSURE")/tests/tile_edges"
 
-# fractures NAME.json: the sidecar's fracture count
-fractures() { sed -n 's/.*"fractures": *\([0-9]*\).*/\1/p' "$1" | head -1; }
-
 for preset in mud-springs hex-springs bark-springs multilayer-springs curl-springs; do
     case $preset in
         multilayer-springs) n=400 ;;

@@ -2,8 +2,6 @@
 # maps and fractures; the same seed gives identical bytes, and so do -j 1 and -j 2.
 . "$top_srcdir/tests/lib.sh"
 
-# fractures N from a sidecar
-fractures() { sed -n 's/^ *"fractures": *\([0-9]*\),*$/\1/p' "$1"; }
 
 mud="--size 128x128 --set mesh.elements=800"
 expect_status 0 "mud-thick runs" "$FISSURE" -q -j 1 -o "$tmp/mud-a" -n x $mud mud-thick
@@ -25,10 +23,29 @@ done
 cmp -s "$tmp/mud-a/x_cracks.json" "$tmp/mud-j2/x_cracks.json" && ok "mud-thick crack graph: -j 1 and -j 2 identical" \
     || not_ok "mud-thick crack graph: -j 1 and -j 2 identical"
 
-# Bark (the direction of its fissures is test_tet's: their walls within 20 degrees of the axis).
-expect_status 0 "bark-tet runs" "$FISSURE" -q -o "$tmp/bark" -n x --size 128x128 --set mesh.elements=800 bark-tet
+# Thinner layers crack into smaller pieces: mud-thick at its own mesh and seed, its layer halved,
+# breaks into 2 to 5 times as many fragments (the crack graph's closed pieces; 18 and 54 when
+# this test was written).
+expect_status 0 "mud-thick at its thickness" "$FISSURE" -q -o "$tmp/thick" -n x --size 256x256 mud-thick
+expect_status 0 "mud-thick at half its thickness" "$FISSURE" -q -o "$tmp/thin" -n x --size 256x256 \
+    --set material.thickness=0.3 mud-thick
+f1=$(fragments "$tmp/thick/x_cracks.json"); f2=$(fragments "$tmp/thin/x_cracks.json")
+if [ "${f1:-0}" -gt 0 ] && [ $((2 * f1)) -le "${f2:-0}" ] && [ "${f2:-0}" -le $((5 * f1)) ]; then
+    ok "mud-thick: halving the thickness gives 2-5x the fragments ($f1 -> $f2)"
+else
+    not_ok "mud-thick: halving the thickness gives 2-5x the fragments (got '$f1' -> '$f2')"
+fi
+
+# Bark at its own mesh: the fissures (the crack graph's polylines at least 1 cm from end to end)
+# run within 20 degrees of the trunk's axis for at least 90 % of their length (the texture spans
+# the trunk's 31.4 cm girth across and its 20 cm height up).
+STATS="$(dirname "$FISSURE")/tests/crack_stats"
+expect_status 0 "bark-tet runs" "$FISSURE" -q -o "$tmp/bark" -n x --size 256x256 bark-tet
 n=$(fractures "$tmp/bark/x.json")
 [ "${n:-0}" -gt 20 ] && ok "bark-tet: nodes split ($n)" || not_ok "bark-tet: nodes split (got '$n')"
+set -- $("$STATS" directions "$tmp/bark/x_cracks.json" 31.416 20 1 20)
+awk_true "${1:-0} >= 0.9 && ${2:-0} >= 10" && ok "bark-tet: fissures along the axis ($1 of $3 cm in $2 chords within 20 degrees)" \
+    || not_ok "bark-tet: fissures along the axis (got '$1' of '$3' cm in '$2' chords within 20 degrees)"
 
 # The glaze on a growing sphere crazes into pieces.
 expect_status 0 "glaze-tet runs" "$FISSURE" -q -o "$tmp/glaze" -n x --size 128x64 --set mesh.elements=800 glaze-tet

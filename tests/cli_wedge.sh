@@ -3,8 +3,6 @@
 . "$top_srcdir/tests/lib.sh"
 
 small="--size 64x64 --set mesh.elements=900"
-# fractures N from a sidecar
-fractures() { sed -n 's/^ *"fractures": *\([0-9]*\),*$/\1/p' "$1"; }
 
 for preset in mud-remove bark-remove; do
     expect_status 0 "$preset runs" "$FISSURE" -q -o "$tmp/$preset-a" -n x $small "$preset"

@@ -1,11 +1,14 @@
-/* Test helper: measures a crack mask, for the shell tests of the crack presets (orientation, density inside a map). */
+/* Test helper: measures a crack mask or a crack graph, for the shell tests of the crack presets (orientation, density inside a map). */
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/error.h"
+#include "base/vec.h"
 #include "image/image.h"
+#include "io/json.h"
 
 /* A crack pixel: at least half white in the anti-aliased mask. */
 #define CRACK 0.5f
@@ -14,7 +17,8 @@ static int usage(void)
 {
     fprintf(stderr, "usage: crack_stats runs MASK.png [V0 V1 [U0 U1]]\n"
                     "       crack_stats inside MASK.png GREY.png LEVEL\n"
-                    "       crack_stats crossings CELLID.png U0 U1\n");
+                    "       crack_stats crossings CELLID.png U0 U1\n"
+                    "       crack_stats directions CRACKS.json SPAN_U SPAN_V MIN_CHORD DEGREES\n");
     return 2;
 }
 
@@ -169,12 +173,56 @@ static int crossings(int argc, char **argv)
     return 0;
 }
 
+/* The share of the crack graph's length that runs within DEGREES of the v direction (a trunk's
+ * axis): each polyline counts by its chord, from its first point to its last, in centimetres (the
+ * texture's spans SPAN_U x SPAN_V); chords shorter than MIN_CHORD (the element-scale wiggle of
+ * short branches) are left out. Prints "SHARE CHORDS LENGTH". */
+static int directions(int argc, char **argv)
+{
+    if (argc != 7)
+        return usage();
+    double span[2] = {atof(argv[3]), atof(argv[4])}, min_chord = atof(argv[5]), degrees = atof(argv[6]);
+    fs_json *root = fs_json_read(argv[2]);
+    if (!root) {
+        fprintf(stderr, "crack_stats: %s: %s\n", argv[2], fs_error_message());
+        return 1;
+    }
+    fs_json *cracks = fs_json_get(root, "cracks");
+    double total = 0.0, within = 0.0;
+    long chords = 0;
+    for (size_t c = 0; c < fs_json_size(cracks); c++) {
+        fs_json *lines = fs_json_get(fs_json_at(cracks, c), "polylines");
+        for (size_t l = 0; l < fs_json_size(lines); l++) {
+            fs_json *line = fs_json_at(lines, l);
+            size_t n = fs_json_size(line);
+            if (n < 2)
+                continue;
+            double d[2];
+            for (int k = 0; k < 2; k++)
+                d[k] = (fs_json_number(fs_json_at(fs_json_at(line, n - 1), (size_t)k)) -
+                        fs_json_number(fs_json_at(fs_json_at(line, 0), (size_t)k))) * span[k];
+            double len = hypot(d[0], d[1]);
+            if (len < min_chord)
+                continue;
+            chords++;
+            total += len;
+            if (atan2(fabs(d[0]), fabs(d[1])) <= degrees * FS_PI / 180.0)
+                within += len;
+        }
+    }
+    fs_json_free(root);
+    printf("%.4f %ld %.3f\n", total > 0.0 ? within / total : 0.0, chords, total);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2)
         return usage();
     if (!strcmp(argv[1], "runs"))
         return runs(argc, argv);
+    if (!strcmp(argv[1], "directions"))
+        return directions(argc, argv);
     if (!strcmp(argv[1], "inside"))
         return inside(argc, argv);
     if (!strcmp(argv[1], "crossings"))

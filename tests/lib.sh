@@ -42,6 +42,11 @@ json_get() {
             if (substr(path "." key($0), 2) == want) { print v; exit }
         }' "$1"
 }
+# fractures SIDECAR: the run's fracture count; fragments CRACKS.json: the crack graph's fragments
+fractures() { sed -n 's/^ *"fractures": *\([0-9]*\),*$/\1/p' "$1" | head -n 1; }
+fragments() { sed -n 's/^ *"fragments": *\([0-9]*\),*$/\1/p' "$1" | head -n 1; }
+# awk_true EXPR: exit 0 if the awk expression is true (compares decimals)
+awk_true() { awk "BEGIN { exit !($1) }"; }
 finish() {
     if [ "$failures" -eq 0 ]; then exit 0; fi
     printf '%d failure(s)\n' "$failures"; exit 1
