@@ -10,7 +10,8 @@ tmp=$(mktemp -d "${TMPDIR:-/tmp}/fissure-gallery.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
 mkdir -p "$out"
 
-# preset, map size, overrides that make the run small (fewer elements than the preset's default)
+# preset, map size, overrides that make the run small (fewer elements than the preset's default;
+# none where the default is what shows the pattern)
 while read -r preset size sets; do
     set --
     for s in $sets; do set -- "$@" --set "$s"; done
@@ -34,4 +35,7 @@ sphere-elongated 256x128 mesh.elements=3000
 bark-siberian-elm 256x256 mesh.elements=3000
 bark-flowering-dogwood 256x256 mesh.elements=3000
 bark-black-hickory 256x256 mesh.elements=4000
+mud-thick 256x256
+bark-tet 256x163
+glaze-tet 256x128 mesh.elements=3000
 LIST
