@@ -206,6 +206,42 @@ static void test_builder_sums_duplicates(void)
     fs_sparse_builder_free(&b);
 }
 
+/* A builder cleared and reused for patterns of other orders and sizes (as a model rebuilds its
+ * pattern after each cut) compresses each exactly as a fresh builder does. */
+static void test_builder_reused(void)
+{
+    fs_sparse_builder reused;
+    fs_sparse_builder_init(&reused, 1, 0);
+    const int32_t orders[] = {9, 3, 20, 5};
+    for (int round = 0; round < 4; round++) {
+        int32_t n = orders[round];
+        fs_sparse_builder fresh;
+        fs_sparse_builder_init(&fresh, n, 0);
+        fs_sparse_builder_clear(&reused, n);
+        for (int32_t e = 0; e < 6 * n; e++) { /* a fixed pseudo-random sequence of entries */
+            int32_t r = (int32_t)((e * 7 + round * 3) % n), c = (int32_t)((e * 13 + 5) % n);
+            double v = 1.0 + 0.25 * e - round;
+            fs_sparse_builder_add(&fresh, r, c, v);
+            fs_sparse_builder_add(&reused, r, c, v);
+        }
+        int32_t slots_a[6 * 20], slots_b[6 * 20];
+        fs_sparse_matrix a, b;
+        CHECK(fs_sparse_builder_compress(&fresh, &a, slots_a) == 0);
+        CHECK(fs_sparse_builder_compress(&reused, &b, slots_b) == 0);
+        CHECK(a.n == n && b.n == n && fs_sparse_matrix_nnz(&a) == fs_sparse_matrix_nnz(&b));
+        for (int32_t j = 0; j <= n; j++)
+            CHECK(a.col_ptr[j] == b.col_ptr[j]);
+        for (int32_t p = 0; p < fs_sparse_matrix_nnz(&a); p++)
+            CHECK(a.row_idx[p] == b.row_idx[p] && a.values[p] == b.values[p]);
+        for (int32_t e = 0; e < 6 * n; e++)
+            CHECK(slots_a[e] == slots_b[e]);
+        fs_sparse_matrix_free(&a);
+        fs_sparse_matrix_free(&b);
+        fs_sparse_builder_free(&fresh);
+    }
+    fs_sparse_builder_free(&reused);
+}
+
 static void test_matvec_matches_dense(void)
 {
     enum { n = 7 };
@@ -1030,6 +1066,7 @@ static void test_cholesky_independent_of_blas_threads(void)
 int main(void)
 {
     RUN(test_builder_sums_duplicates);
+    RUN(test_builder_reused);
     RUN(test_matvec_matches_dense);
     RUN(test_principal_submatrix);
     RUN(test_slots_reproduce_fresh_assembly);

@@ -24,6 +24,8 @@ void fs_sparse_builder_init(fs_sparse_builder *b, int32_t n, size_t capacity_hin
     b->rows = fs_malloc(capacity_hint * sizeof *b->rows);
     b->cols = fs_malloc(capacity_hint * sizeof *b->cols);
     b->values = fs_malloc(capacity_hint * sizeof *b->values);
+    b->scratch = NULL;
+    b->scratch_size = 0;
 }
 
 void fs_sparse_builder_free(fs_sparse_builder *b)
@@ -31,10 +33,16 @@ void fs_sparse_builder_free(fs_sparse_builder *b)
     free(b->rows);
     free(b->cols);
     free(b->values);
+    free(b->scratch);
     memset(b, 0, sizeof *b);
 }
 
-void fs_sparse_builder_clear(fs_sparse_builder *b) { b->count = 0; }
+void fs_sparse_builder_clear(fs_sparse_builder *b, int32_t n)
+{
+    FS_ASSERT(n >= 0);
+    b->n = n;
+    b->count = 0;
+}
 
 static void builder_reserve(fs_sparse_builder *b, size_t extra)
 {
@@ -78,13 +86,19 @@ int32_t fs_sparse_builder_add_block(fs_sparse_builder *b, int32_t k, const int32
 /* design: two stable counting sorts, by row and then by column, leave each column's entries in increasing
  * row order with the entries of one (row, column) pair in entry order; merging runs of equal rows then
  * sums duplicates in entry order, which fs_sparse_matrix_add_block repeats exactly. O(n + count). */
-int fs_sparse_builder_compress(const fs_sparse_builder *b, fs_sparse_matrix *out, int32_t *slots)
+int fs_sparse_builder_compress(fs_sparse_builder *b, fs_sparse_matrix *out, int32_t *slots)
 {
     int32_t n = b->n;
     size_t count = b->count;
-    size_t *start = fs_calloc((size_t)n + 1, sizeof *start);
-    size_t *by_row = fs_malloc(count * sizeof *by_row);
-    size_t *order = fs_malloc(count * sizeof *order);
+    size_t need = 2 * ((size_t)n + 1) + 2 * count;
+    if (need > b->scratch_size) {
+        free(b->scratch);
+        b->scratch = fs_malloc(need * sizeof *b->scratch);
+        b->scratch_size = need;
+    }
+    size_t *start = b->scratch, *cursor = start + (size_t)n + 1, *by_row = cursor + (size_t)n + 1,
+           *order = by_row + count;
+    memset(start, 0, ((size_t)n + 1) * sizeof *start);
 
     for (size_t e = 0; e < count; e++)
         start[b->rows[e] + 1]++;
@@ -98,14 +112,11 @@ int fs_sparse_builder_compress(const fs_sparse_builder *b, fs_sparse_matrix *out
         start[b->cols[e] + 1]++;
     for (int32_t j = 0; j < n; j++)
         start[j + 1] += start[j];
-    size_t *cursor = fs_malloc(((size_t)n + 1) * sizeof *cursor);
     memcpy(cursor, start, ((size_t)n + 1) * sizeof *cursor);
     for (size_t k = 0; k < count; k++) {
         size_t e = by_row[k];
         order[cursor[b->cols[e]]++] = e;
     }
-    free(cursor);
-    free(by_row);
 
     size_t nnz = 0;
     for (int32_t j = 0; j < n; j++) {
@@ -120,8 +131,6 @@ int fs_sparse_builder_compress(const fs_sparse_builder *b, fs_sparse_matrix *out
             nnz++;
     }
     if (nnz > (size_t)INT32_MAX) {
-        free(start);
-        free(order);
         fs_error(FS_ERR_INTERNAL, "sparse: %zu stored entries exceed the 32-bit index range", nnz);
         return -1;
     }
@@ -154,8 +163,6 @@ int fs_sparse_builder_compress(const fs_sparse_builder *b, fs_sparse_matrix *out
         }
     }
     out->col_ptr[n] = p;
-    free(start);
-    free(order);
     return 0;
 }
 

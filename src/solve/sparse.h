@@ -31,6 +31,8 @@ typedef struct {
     int32_t *rows;    /* per entry: the smaller of its two indices (upper triangle) */
     int32_t *cols;    /* per entry: the larger of its two indices */
     double *values;   /* per entry: its value */
+    size_t *scratch;  /* compression's work space, kept for the next compression */
+    size_t scratch_size;
 } fs_sparse_builder;
 
 /* Starts an empty builder for an n×n matrix (n >= 0). capacity_hint entries are reserved (0 is fine);
@@ -38,8 +40,10 @@ typedef struct {
 void fs_sparse_builder_init(fs_sparse_builder *b, int32_t n, size_t capacity_hint);
 void fs_sparse_builder_free(fs_sparse_builder *b);
 
-/* Forgets all entries (keeps the storage) so the builder can assemble a new pattern of the same order. */
-void fs_sparse_builder_clear(fs_sparse_builder *b);
+/* Forgets all entries (keeps the storage) so the builder can assemble a new pattern of order n; a
+ * builder that assembles pattern after pattern (a model whose mesh changes) reuses its arrays and its
+ * compression's work space instead of allocating them afresh each time. */
+void fs_sparse_builder_clear(fs_sparse_builder *b, int32_t n);
 
 /* Adds value at (row, col), 0 <= row, col < n (checked with FS_ASSERT). Returns the entry number. */
 size_t fs_sparse_builder_add(fs_sparse_builder *b, int32_t row, int32_t col, double value);
@@ -55,9 +59,9 @@ int32_t fs_sparse_builder_add_block(fs_sparse_builder *b, int32_t k, const int32
 /* Compresses the entries into out (which must not hold arrays: it is overwritten), summing duplicates in
  * entry order and inserting a zero diagonal entry where a column has none. If slots is not NULL it has
  * b->count elements and receives, for each entry number, the index into out->values the entry was summed
- * into. The builder is unchanged. Returns 0, or -1 with FS_ERR_INTERNAL if the matrix has more than
- * INT32_MAX stored entries. */
-int fs_sparse_builder_compress(const fs_sparse_builder *b, fs_sparse_matrix *out, int32_t *slots);
+ * into. The builder's entries are unchanged (it keeps the work space). Returns 0, or -1 with
+ * FS_ERR_INTERNAL if the matrix has more than INT32_MAX stored entries. */
+int fs_sparse_builder_compress(fs_sparse_builder *b, fs_sparse_matrix *out, int32_t *slots);
 
 /* Releases the arrays of m and zeroes the struct (a zeroed struct may be freed again). */
 void fs_sparse_matrix_free(fs_sparse_matrix *m);

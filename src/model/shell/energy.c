@@ -431,8 +431,8 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
     sys->chol = NULL;
     sys->factored = false;
     int32_t nt = scope_tris(s, sys), nn = scope_nodes(s, sys);
-    fs_sparse_builder b;
-    fs_sparse_builder_init(&b, sys->n_free, (size_t)nt * 171 + (size_t)nn * 6);
+    fs_sparse_builder *b = &s->pattern;
+    fs_sparse_builder_clear(b, sys->n_free);
     double zero[18 * 18];
     memset(zero, 0, sizeof zero);
     for (int32_t q = 0; q < nt; q++) {
@@ -440,14 +440,13 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
         int loc[3], opp[3];
         int k = stencil(s, scope_tri(sys, q), nodes, loc, opp);
         block_dofs(sys, nodes, k, idx);
-        fs_sparse_builder_add_block(&b, 3 * k, idx, zero);
+        fs_sparse_builder_add_block(b, 3 * k, idx, zero);
     }
     for (int32_t q = 0; q < nn; q++)
-        fs_sparse_builder_add_block(&b, 3, sys->dof + 3 * (size_t)scope_node(sys, q), zero);
-    sys->n_slots = b.count;
-    sys->slots = fs_malloc((b.count + 1) * sizeof *sys->slots);
-    int rc = fs_sparse_builder_compress(&b, &sys->K, sys->slots);
-    fs_sparse_builder_free(&b);
+        fs_sparse_builder_add_block(b, 3, sys->dof + 3 * (size_t)scope_node(sys, q), zero);
+    sys->n_slots = b->count;
+    sys->slots = fs_malloc((b->count + 1) * sizeof *sys->slots);
+    int rc = fs_sparse_builder_compress(b, &sys->K, sys->slots);
     if (rc < 0)
         return -1;
     sys->pattern_valid = true;

@@ -154,6 +154,8 @@ struct fs_shell {
     double *grad;                  /* 3 per node: gradient of the energy at x */
     double *work;                  /* scratch: 2 n_free + 6 n_nodes (reallocated to fit) */
     size_t work_size;
+    fs_sparse_builder pattern;     /* scratch of every Hessian pattern built (the whole shell's after
+                                      each cut, each local region's): its arrays are reused */
 
     int64_t fractures;
     fs_shell_counters counters;

@@ -398,6 +398,7 @@ void fs_shell_destroy(fs_shell *s)
     free(s->phi);
     free(s->dphi);
     free(s->work);
+    fs_sparse_builder_free(&s->pattern);
     fs_shell_system_free(&s->sys);
     free(s);
 }
