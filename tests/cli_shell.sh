@@ -44,4 +44,17 @@ mesh_preset "$tmp/missing.obj"
 expect_status 66 "a missing mesh file exits 66" "$FISSURE" -q -o "$tmp/missing-out" "$tmp/mesh.ini"
 grep -qF "missing.obj: cannot open the mesh" "$tmp/stderr" || not_ok "the missing mesh is named"
 
+# A crack crossing a UV seam continues on the other side: glaze on a coarse vase (tests/vase-coarse.obj,
+# textures/vase.py at 32 x 14; its side's seam and the base's rim are UV seams), crack mask at 1024 px.
+# Along every interior edge, the runs of crack just inside one side are matched with crack just
+# inside the other side; the seams must match about as well as the ordinary edges do (the
+# measure misses a crack that ends at an edge or leaves a short edge's window, on either kind).
+expect_status 0 "glaze on a coarse vase runs" "$FISSURE" -q -o "$tmp/seam" -n x --size 1024x1024 --maps crackmask \
+    --set domain.file="$top_srcdir/tests/vase-coarse.obj" glaze
+set -- $("$(dirname "$FISSURE")/tests/seam_check" "$top_srcdir/tests/vase-coarse.obj" "$tmp/seam/x_crackmask.png")
+if [ "${2:-0}" -ge 10 ] && awk_true "${3:-0} / ${2:-1} >= ${6:-0} / ${5:-1} - 0.15"; then
+    ok "cracks continue across UV seams ($3 of $2 runs on $1 seam edges; $6 of $5 on $4 other edges)"
+else
+    not_ok "cracks continue across UV seams (got '$3' of '$2' runs on seams; '$6' of '$5' elsewhere)"
+fi
 finish

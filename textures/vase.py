@@ -8,7 +8,10 @@ same cm per texture unit as u at the belly) and the base as a disc below it. The
 piece: the side's seam and the base's rim are UV seams only (their positions are shared).
 Positions in cm, outward-facing counter-clockwise faces. Deterministic: no randomness.
 
-    python3 textures/vase.py [OUT.obj]
+    python3 textures/vase.py [OUT.obj [AROUND ROWS]]
+
+AROUND and ROWS (default 88 and 40) set the segments around and the rows up the side: the tests
+make a coarse vase of a few hundred triangles with them.
 """
 
 import math
@@ -29,7 +32,10 @@ def radius(z):
 
 
 def main():
+    global AROUND, PROFILE_ROWS
     out = sys.argv[1] if len(sys.argv) > 1 else "textures/vase.obj"
+    if len(sys.argv) > 3:
+        AROUND, PROFILE_ROWS = int(sys.argv[2]), int(sys.argv[3])
     # rows spaced evenly by arc length along the profile
     fine = [HEIGHT * i / 4000.0 for i in range(4001)]
     arc = [0.0]
