@@ -92,6 +92,7 @@ static uint64_t mesh_hash(const fs_mesh *m)
 
 int main(int argc, char **argv)
 {
+    fs_alloc_setup(); /* as the command line tool does */
     char *end;
     if (argc >= 3 && strcmp(argv[1], "-j") == 0) {
         errno = 0;
