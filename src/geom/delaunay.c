@@ -282,10 +282,17 @@ static bool all_coplanar(const double *pos, int32_t n, double scale)
     return true;
 }
 
-/* Whether the triangle with doubled signed area o is too flat to keep. */
+/* Whether the triangle with doubled signed area o is too flat to keep. A sine well above the limit
+ * (the squares compared with a factor 2 to spare, far beyond rounding) answers without the two
+ * hypot calls; near the limit, or for lengths whose squares could underflow or overflow, the test
+ * is the exact one. */
 static bool is_flat(const double *a, const double *b, const double *c, double o)
 {
-    double ab = hypot(b[0] - a[0], b[1] - a[1]), ac = hypot(c[0] - a[0], c[1] - a[1]);
+    double bx = b[0] - a[0], by = b[1] - a[1], cx = c[0] - a[0], cy = c[1] - a[1];
+    double q = (bx * bx + by * by) * (cx * cx + cy * cy);
+    if (q > 1e-200 && q < 1e200 && o * o > 2.0 * FLAT_SINE * FLAT_SINE * q)
+        return false;
+    double ab = hypot(bx, by), ac = hypot(cx, cy);
     return fabs(o) <= FLAT_SINE * ab * ac;
 }
 
@@ -582,6 +589,26 @@ static double disc_half_extent(const plane_setup *s, int d, const double *c, con
     return half2 > 0.0 ? sqrt(half2) : 0.0;
 }
 
+/* Whether the circle with centre c and squared radius r2 lies inside the region [lo, hi) as
+ * run_block's test measures it, decided without its hypot: the bound sqrt(r2) (1 + 1e-9) is at
+ * least hypot's radius whenever r2 is a normal number, rounding is monotonic, and the whole disc
+ * is what disc_half_extent measures when the centre lies in the band. Otherwise (false) the exact
+ * test decides. */
+static bool circle_surely_inside(const plane_setup *s, const double *c, double r2, const double *lo, const double *hi)
+{
+    if (!(r2 > 1e-290 && r2 < 1e290))
+        return false;
+    double half = sqrt(r2) * (1.0 + 1e-9) + s->slack;
+    for (int d = 0; d < 2; d++) {
+        int o = 1 - d;
+        if (!(s->period[o] > 0.0 || (c[o] >= s->lo[o] && c[o] <= s->hi[o])))
+            return false;
+        if (!(c[d] - half >= lo[d] && c[d] + half <= hi[d]))
+            return false;
+    }
+    return true;
+}
+
 /* The region whose points (and images) block b copies: the block widened by the margin, the whole
  * period plus the margin across a wrapping direction, unbounded at the outer ends of a direction
  * that does not wrap. */
@@ -738,13 +765,15 @@ static void run_block(block_job *job)
                 double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
                 double ux = (cy * b2 - by * c2) / dd, uy = (bx * c2 - cx * b2) / dd;
                 double cc[2] = {pa[0] + ux, pa[1] + uy};
-                double r = hypot(ux, uy);
-                for (int d = 0; d < 2; d++) {
-                    double half = disc_half_extent(s, d, cc, pa, r) + s->slack;
-                    if (cc[d] - half < lo[d])
-                        needed = fmax(needed, job->margin + (lo[d] - (cc[d] - half)));
-                    if (cc[d] + half > hi[d])
-                        needed = fmax(needed, job->margin + (cc[d] + half - hi[d]));
+                if (!circle_surely_inside(s, cc, ux * ux + uy * uy, lo, hi)) {
+                    double r = hypot(ux, uy);
+                    for (int d = 0; d < 2; d++) {
+                        double half = disc_half_extent(s, d, cc, pa, r) + s->slack;
+                        if (cc[d] - half < lo[d])
+                            needed = fmax(needed, job->margin + (lo[d] - (cc[d] - half)));
+                        if (cc[d] + half > hi[d])
+                            needed = fmax(needed, job->margin + (cc[d] + half - hi[d]));
+                    }
                 }
             }
             const int8_t *sf = shift + 2 * (size_t)e[first];
