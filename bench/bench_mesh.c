@@ -24,7 +24,7 @@ static void usage(void)
                     "  samples N points about %g cm apart by particle repulsion (or uniformly at random with\n"
                     "  'uniform'), triangulates them and builds the Voronoi dual on THREADS threads (default:\n"
                     "  one per processor); prints one line of timings and a hash of the mesh (positions,\n"
-                    "  triangles and image shifts), which must not depend on THREADS.\n",
+                    "  triangles, shifts, adjacency, edges, rings), which must not depend on THREADS.\n",
             BENCH_SPACING);
 }
 
@@ -81,13 +81,21 @@ static uint64_t hash_bytes(uint64_t h, const void *data, size_t n)
     return h;
 }
 
-/* A hash of what the mesh hands on: positions, triangles (corners in order) and image shifts. */
+/* A hash of what the mesh hands on: positions, triangles (corners in order), image shifts,
+ * adjacency, edges and rings. */
 static uint64_t mesh_hash(const fs_mesh *m)
 {
+    size_t nt = (size_t)m->n_tris, ne = (size_t)m->n_edges;
     uint64_t h = UINT64_C(0xcbf29ce484222325);
     h = hash_bytes(h, m->pos, 3 * (size_t)m->n_nodes * sizeof *m->pos);
-    h = hash_bytes(h, m->tri, 3 * (size_t)m->n_tris * sizeof *m->tri);
-    return hash_bytes(h, m->shift, 6 * (size_t)m->n_tris * sizeof *m->shift);
+    h = hash_bytes(h, m->tri, 3 * nt * sizeof *m->tri);
+    h = hash_bytes(h, m->shift, 6 * nt * sizeof *m->shift);
+    h = hash_bytes(h, m->adj, 3 * nt * sizeof *m->adj);
+    h = hash_bytes(h, m->edge, 2 * ne * sizeof *m->edge);
+    h = hash_bytes(h, m->edge_tri, 2 * ne * sizeof *m->edge_tri);
+    h = hash_bytes(h, m->tri_edge, 3 * nt * sizeof *m->tri_edge);
+    h = hash_bytes(h, m->ring_start, ((size_t)m->n_nodes + 1) * sizeof *m->ring_start);
+    return hash_bytes(h, m->ring_tri, (size_t)m->ring_start[m->n_nodes] * sizeof *m->ring_tri);
 }
 
 int main(int argc, char **argv)
