@@ -537,12 +537,33 @@ void fs_mesh_drop_derived(fs_mesh *m)
     m->n_edges = 0;
 }
 
+/* Partners of part p of the half-edges (fs_mesh_build_edges' first pass). */
+typedef struct {
+    const fs_mesh *m;
+    int parts;
+    int32_t *partner;
+} partner_pass;
+
+static void partners_of_part(void *ctx, int32_t p)
+{
+    partner_pass *pp = ctx;
+    int32_t h0, h1;
+    fs_parallel_part(3 * pp->m->n_tris, pp->parts, p, &h0, &h1);
+    for (int32_t h = h0; h < h1; h++)
+        pp->partner[h] = partner(pp->m, h);
+}
+
+/* design: edges are numbered in the order of their first half-edge. The partners, the costly part,
+ * are found first, in parallel for a large mesh (each half-edge's on its own); the numbering is one
+ * pass in half-edge order, as before, so it does not depend on the thread count. */
 void fs_mesh_build_edges(fs_mesh *m)
 {
     int32_t nh = 3 * m->n_tris;
     free(m->edge);
     free(m->edge_tri);
     free(m->tri_edge);
+    partner_pass pp = {m, mesh_parts(nh, m->n_nodes), fs_malloc((size_t)(nh ? nh : 1) * sizeof(int32_t))};
+    fs_parallel_for(pp.parts, pp.parts, partners_of_part, &pp);
     m->tri_edge = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->tri_edge);
     for (int32_t h = 0; h < nh; h++)
         m->tri_edge[h] = -1;
@@ -552,17 +573,18 @@ void fs_mesh_build_edges(fs_mesh *m)
     for (int32_t h = 0; h < nh; h++) {
         if (m->tri_edge[h] >= 0)
             continue;
-        half_edge e = half_edge_of(m, h);
-        edge[2 * ne] = e.from < e.to ? e.from : e.to;
-        edge[2 * ne + 1] = e.from < e.to ? e.to : e.from;
+        int32_t a = m->tri[h], b = m->tri[3 * (h / 3) + (h % 3 + 1) % 3];
+        edge[2 * ne] = a < b ? a : b;
+        edge[2 * ne + 1] = a < b ? b : a;
         edge_tri[2 * ne] = h / 3;
         edge_tri[2 * ne + 1] = m->adj[h];
         m->tri_edge[h] = ne;
-        int32_t g = partner(m, h);
+        int32_t g = pp.partner[h];
         if (g >= 0)
             m->tri_edge[g] = ne;
         ne++;
     }
+    free(pp.partner);
     m->n_edges = ne;
     m->edge = fs_realloc(edge, (size_t)(ne ? ne : 1) * 2 * sizeof *edge);
     m->edge_tri = fs_realloc(edge_tri, (size_t)(ne ? ne : 1) * 2 * sizeof *edge_tri);
@@ -599,34 +621,51 @@ static void walk_node(const fs_mesh *m, const int32_t *corners, int32_t deg, uin
     }
 }
 
+/* The shared state of fs_mesh_build_rings' parallel pass. */
+typedef struct {
+    fs_mesh *m;
+    int parts;
+    const int32_t *start, *corner;
+    uint8_t *visited;
+    int32_t maxdeg;
+} ring_pass;
+
+/* The rings of part p of the nodes (a node's corners are its own: no two parts touch one). */
+static void rings_of_part(void *ctx, int32_t p)
+{
+    ring_pass *rp = ctx;
+    fs_mesh *m = rp->m;
+    int32_t v0, v1;
+    fs_parallel_part(m->n_nodes, rp->parts, p, &v0, &v1);
+    int32_t *order = fs_malloc((size_t)(rp->maxdeg ? rp->maxdeg : 1) * sizeof *order);
+    uint8_t *flags = fs_malloc((size_t)(rp->maxdeg ? rp->maxdeg : 1));
+    for (int32_t v = v0; v < v1; v++) {
+        int32_t s = rp->start[v], deg = rp->start[v + 1] - s;
+        walk_node(m, rp->corner + s, deg, rp->visited, order, flags);
+        m->ring_start[v] = s;
+        for (int32_t i = 0; i < deg; i++)
+            m->ring_tri[s + i] = order[i] / 3;
+    }
+    free(order);
+    free(flags);
+}
+
 void fs_mesh_build_rings(fs_mesh *m)
 {
     int32_t *start, *corner;
     node_half_edges(m, &start, &corner);
     int32_t nh = 3 * m->n_tris;
-    uint8_t *visited = fs_calloc((size_t)(nh ? nh : 1), 1);
-    int32_t maxdeg = 0;
+    ring_pass rp = {m, mesh_parts(nh, m->n_nodes), start, corner, fs_calloc((size_t)(nh ? nh : 1), 1), 0};
     for (int32_t v = 0; v < m->n_nodes; v++)
-        if (start[v + 1] - start[v] > maxdeg)
-            maxdeg = start[v + 1] - start[v];
-    int32_t *order = fs_malloc((size_t)(maxdeg ? maxdeg : 1) * sizeof *order);
-    uint8_t *flags = fs_malloc((size_t)(maxdeg ? maxdeg : 1));
-
+        if (start[v + 1] - start[v] > rp.maxdeg)
+            rp.maxdeg = start[v + 1] - start[v];
     free(m->ring_start);
     free(m->ring_tri);
     m->ring_start = fs_malloc(((size_t)m->n_nodes + 1) * sizeof *m->ring_start);
     m->ring_tri = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->ring_tri);
-    for (int32_t v = 0; v < m->n_nodes; v++) {
-        int32_t deg = start[v + 1] - start[v];
-        walk_node(m, corner + start[v], deg, visited, order, flags);
-        m->ring_start[v] = start[v];
-        for (int32_t i = 0; i < deg; i++)
-            m->ring_tri[start[v] + i] = order[i] / 3;
-    }
+    fs_parallel_for(rp.parts, rp.parts, rings_of_part, &rp);
     m->ring_start[m->n_nodes] = nh;
-    free(order);
-    free(flags);
-    free(visited);
+    free(rp.visited);
     free(start);
     free(corner);
 }
