@@ -23,8 +23,8 @@ static void usage(void)
     fprintf(stderr, "usage: bench_mesh [-j THREADS] N [plane|periodic|cylinder|sphere] [uniform]\n"
                     "  samples N points about %g cm apart by particle repulsion (or uniformly at random with\n"
                     "  'uniform'), triangulates them and builds the Voronoi dual on THREADS threads (default:\n"
-                    "  one per processor); prints one line of timings and a hash of the mesh (positions,\n"
-                    "  triangles, shifts, adjacency, edges, rings), which must not depend on THREADS.\n",
+                    "  one per processor); prints one line of timings and the mesh's digest\n"
+                    "  (fs_mesh_digest), which must not depend on THREADS.\n",
             BENCH_SPACING);
 }
 
@@ -70,32 +70,6 @@ static void uniform_points(const fs_domain *d, int32_t n, fs_points *out)
             p[1] = v * fs_domain_extent_y(d);
         }
     }
-}
-
-/* FNV-1a over n bytes, continuing from h. */
-static uint64_t hash_bytes(uint64_t h, const void *data, size_t n)
-{
-    const unsigned char *b = data;
-    for (size_t i = 0; i < n; i++)
-        h = (h ^ b[i]) * UINT64_C(0x100000001b3);
-    return h;
-}
-
-/* A hash of what the mesh hands on: positions, triangles (corners in order), image shifts,
- * adjacency, edges and rings. */
-static uint64_t mesh_hash(const fs_mesh *m)
-{
-    size_t nt = (size_t)m->n_tris, ne = (size_t)m->n_edges;
-    uint64_t h = UINT64_C(0xcbf29ce484222325);
-    h = hash_bytes(h, m->pos, 3 * (size_t)m->n_nodes * sizeof *m->pos);
-    h = hash_bytes(h, m->tri, 3 * nt * sizeof *m->tri);
-    h = hash_bytes(h, m->shift, 6 * nt * sizeof *m->shift);
-    h = hash_bytes(h, m->adj, 3 * nt * sizeof *m->adj);
-    h = hash_bytes(h, m->edge, 2 * ne * sizeof *m->edge);
-    h = hash_bytes(h, m->edge_tri, 2 * ne * sizeof *m->edge_tri);
-    h = hash_bytes(h, m->tri_edge, 3 * nt * sizeof *m->tri_edge);
-    h = hash_bytes(h, m->ring_start, ((size_t)m->n_nodes + 1) * sizeof *m->ring_start);
-    return hash_bytes(h, m->ring_tri, (size_t)m->ring_start[m->n_nodes] * sizeof *m->ring_tri);
 }
 
 int main(int argc, char **argv)
@@ -167,7 +141,7 @@ int main(int argc, char **argv)
     printf("%s n=%ld threads=%d %s=%.2fs delaunay=%.2fs voronoi=%.2fs total=%.2fs triangles=%ld boundary_edges=%ld "
            "mesh=%016llx\n",
            name, n, fs_threads(), uniform ? "uniform" : "sample", t1 - t0, t2 - t1, t3 - t2, t3 - t0, (long)m.n_tris,
-           (long)fs_mesh_count_boundary_edges(&m), (unsigned long long)mesh_hash(&m));
+           (long)fs_mesh_count_boundary_edges(&m), (unsigned long long)fs_mesh_digest(&m));
     fs_voronoi_free(&v);
     fs_mesh_free(&m);
     fs_points_free(&pts);

@@ -78,6 +78,33 @@ int32_t fs_mesh_count_boundary_edges(const fs_mesh *m)
     return count;
 }
 
+/* FNV-1a over n bytes, continuing from h. */
+static uint64_t digest_bytes(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *b = data;
+    for (size_t i = 0; b && i < n; i++)
+        h = (h ^ b[i]) * UINT64_C(0x100000001b3);
+    return h;
+}
+
+uint64_t fs_mesh_digest(const fs_mesh *m)
+{
+    size_t nt = (size_t)m->n_tris, ne = (size_t)m->n_edges;
+    uint64_t h = UINT64_C(0xcbf29ce484222325);
+    h = digest_bytes(h, m->pos, 3 * (size_t)m->n_nodes * sizeof *m->pos);
+    h = digest_bytes(h, m->tri, 3 * nt * sizeof *m->tri);
+    h = digest_bytes(h, m->shift, 6 * nt * sizeof *m->shift);
+    h = digest_bytes(h, m->adj, 3 * nt * sizeof *m->adj);
+    h = digest_bytes(h, m->edge, 2 * ne * sizeof *m->edge);
+    h = digest_bytes(h, m->edge_tri, 2 * ne * sizeof *m->edge_tri);
+    h = digest_bytes(h, m->tri_edge, 3 * nt * sizeof *m->tri_edge);
+    if (m->ring_start) {
+        h = digest_bytes(h, m->ring_start, ((size_t)m->n_nodes + 1) * sizeof *m->ring_start);
+        h = digest_bytes(h, m->ring_tri, (size_t)m->ring_start[m->n_nodes] * sizeof *m->ring_tri);
+    }
+    return h;
+}
+
 /* Half-edge h = 3 t + i runs from corner i to corner (i + 1) % 3 of triangle t: its nodes, and the
  * image offset of its end relative to its start (zero off the seams). */
 typedef struct {
