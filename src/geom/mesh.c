@@ -594,12 +594,19 @@ void fs_mesh_build_edges(fs_mesh *m)
     m->tri_edge = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->tri_edge);
     for (int32_t h = 0; h < nh; h++)
         m->tri_edge[h] = -1;
-    int32_t *edge = fs_malloc((size_t)(nh ? nh : 1) * 2 * sizeof *edge);
-    int32_t *edge_tri = fs_malloc((size_t)(nh ? nh : 1) * 2 * sizeof *edge_tri);
-    int32_t ne = 0;
+    /* room for the edges of a closed mesh (half as many as half-edges) and some boundary: memory
+     * of that size is often at hand, freed by the passes before, where the worst case (an edge per
+     * half-edge) would be mapped and faulted in afresh */
+    int32_t cap = nh / 2 + nh / 16 + 16, ne = 0;
+    int32_t *edge = fs_malloc((size_t)cap * 2 * sizeof *edge);
+    int32_t *edge_tri = fs_malloc((size_t)cap * 2 * sizeof *edge_tri);
     for (int32_t h = 0; h < nh; h++) {
         if (m->tri_edge[h] >= 0)
             continue;
+        if (FS_ARRAY_GROW(cap, ne + 1, 16)) {
+            FS_ARRAY_RESIZE(edge, 2 * (size_t)cap);
+            FS_ARRAY_RESIZE(edge_tri, 2 * (size_t)cap);
+        }
         int32_t a = m->tri[h], b = m->tri[3 * (h / 3) + (h % 3 + 1) % 3];
         edge[2 * ne] = a < b ? a : b;
         edge[2 * ne + 1] = a < b ? b : a;
