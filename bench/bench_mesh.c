@@ -1,4 +1,4 @@
-/* Benchmark of sampling, Delaunay meshing and the Voronoi dual: bench_mesh N [domain] [uniform]. */
+/* Benchmark of sampling, Delaunay meshing and the Voronoi dual: bench_mesh [-j THREADS] N [domain] [uniform]. */
 #include <errno.h>
 #include <math.h>
 #include <stdint.h>
@@ -9,6 +9,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "base/rng.h"
+#include "base/threads.h"
 #include "base/vec.h"
 #include "geom/delaunay.h"
 #include "geom/mesh.h"
@@ -19,9 +20,11 @@
 
 static void usage(void)
 {
-    fprintf(stderr, "usage: bench_mesh N [plane|periodic|cylinder|sphere] [uniform]\n"
+    fprintf(stderr, "usage: bench_mesh [-j THREADS] N [plane|periodic|cylinder|sphere] [uniform]\n"
                     "  samples N points about %g cm apart by particle repulsion (or uniformly at random with\n"
-                    "  'uniform'), triangulates them and builds the Voronoi dual; prints one line of timings.\n",
+                    "  'uniform'), triangulates them and builds the Voronoi dual on THREADS threads (default:\n"
+                    "  one per processor); prints one line of timings and the mesh's digest\n"
+                    "  (fs_mesh_digest), which must not depend on THREADS.\n",
             BENCH_SPACING);
 }
 
@@ -71,11 +74,23 @@ static void uniform_points(const fs_domain *d, int32_t n, fs_points *out)
 
 int main(int argc, char **argv)
 {
+    fs_alloc_setup(); /* as the command line tool does */
+    char *end;
+    if (argc >= 3 && strcmp(argv[1], "-j") == 0) {
+        errno = 0;
+        long j = strtol(argv[2], &end, 10);
+        if (errno || *end || j < 1 || j > FS_THREADS_MAX) {
+            usage();
+            return FS_ERR_USAGE;
+        }
+        fs_threads_set((int)j);
+        argc -= 2;
+        argv += 2;
+    }
     if (argc < 2 || argc > 4) {
         usage();
         return FS_ERR_USAGE;
     }
-    char *end;
     errno = 0;
     long n = strtol(argv[1], &end, 10);
     if (errno || *end || n < 4 || n > INT32_MAX) {
@@ -123,9 +138,10 @@ int main(int argc, char **argv)
         return fs_error_domain();
     }
     double t3 = fs_seconds();
-    printf("%s n=%ld %s=%.2fs delaunay=%.2fs voronoi=%.2fs total=%.2fs triangles=%ld boundary_edges=%ld\n", name, n,
-           uniform ? "uniform" : "sample", t1 - t0, t2 - t1, t3 - t2, t3 - t0, (long)m.n_tris,
-           (long)fs_mesh_count_boundary_edges(&m));
+    printf("%s n=%ld threads=%d %s=%.2fs delaunay=%.2fs voronoi=%.2fs total=%.2fs triangles=%ld boundary_edges=%ld "
+           "mesh=%016llx\n",
+           name, n, fs_threads(), uniform ? "uniform" : "sample", t1 - t0, t2 - t1, t3 - t2, t3 - t0, (long)m.n_tris,
+           (long)fs_mesh_count_boundary_edges(&m), (unsigned long long)fs_mesh_digest(&m));
     fs_voronoi_free(&v);
     fs_mesh_free(&m);
     fs_points_free(&pts);

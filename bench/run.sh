@@ -44,3 +44,7 @@ run 100000 plane uniform
 run 100000 periodic
 run 100000 cylinder
 run 100000 sphere
+# the speed target: a million points on the periodic plane, on one thread and on two (same mesh hash)
+for j in 1 2; do
+    run -j "$j" 1000000 periodic
+done

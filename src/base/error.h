@@ -67,4 +67,10 @@ void *fs_calloc(size_t count, size_t size);
 void *fs_realloc(void *ptr, size_t size);
 char *fs_strdup(const char *s);
 
+/* Tunes the C library's allocator once, at start-up before any thread runs: large blocks that are
+ * freed (a Qhull run's nodes, a block's arrays) stay with the process for the next allocation
+ * instead of going back to the system and being faulted in again page by page, in the worker
+ * threads' arenas too. Only the speed and the resident memory change. A no-op without glibc. */
+void fs_alloc_setup(void);
+
 #endif

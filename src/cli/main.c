@@ -646,6 +646,7 @@ __attribute__((section(".preinit_array"), used)) static void (*const preinit_blo
 
 int main(int argc, char **argv)
 {
+    fs_alloc_setup();
     /* every mode: the termination signals are blocked from the preinit array on, and taken here */
     if (fs_output_cleanup_on_signals() < 0)
         return fail();

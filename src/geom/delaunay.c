@@ -16,6 +16,8 @@
 #define FLAT_SINE 1e-12
 /* Perturbation (in mean spacings) that breaks cocircular ties across seams and block cuts. */
 #define TIE_PERTURBATION 1e-6
+/* Below this many triangles the canonical sort runs on the calling thread. */
+#define CANONICAL_PARALLEL_MIN 100000
 
 /* ---- Qhull ---- */
 
@@ -280,10 +282,17 @@ static bool all_coplanar(const double *pos, int32_t n, double scale)
     return true;
 }
 
-/* Whether the triangle with doubled signed area o is too flat to keep. */
+/* Whether the triangle with doubled signed area o is too flat to keep. A sine well above the limit
+ * (the squares compared with a factor 2 to spare, far beyond rounding) answers without the two
+ * hypot calls; near the limit, or for lengths whose squares could underflow or overflow, the test
+ * is the exact one. */
 static bool is_flat(const double *a, const double *b, const double *c, double o)
 {
-    double ab = hypot(b[0] - a[0], b[1] - a[1]), ac = hypot(c[0] - a[0], c[1] - a[1]);
+    double bx = b[0] - a[0], by = b[1] - a[1], cx = c[0] - a[0], cy = c[1] - a[1];
+    double q = (bx * bx + by * by) * (cx * cx + cy * cy);
+    if (q > 1e-200 && q < 1e200 && o * o > 2.0 * FLAT_SINE * FLAT_SINE * q)
+        return false;
+    double ab = hypot(bx, by), ac = hypot(cx, cy);
     return fabs(o) <= FLAT_SINE * ab * ac;
 }
 
@@ -329,11 +338,103 @@ static bool corner_less(int32_t na, const int8_t *sa, int32_t nb, const int8_t *
     return sa[0] != sb[0] ? sa[0] < sb[0] : sa[1] < sb[1];
 }
 
+/* Triangles from one source (a block, or the whole hull), each already starting at its smallest
+ * corner with shift (0, 0). */
+typedef struct {
+    const int32_t *tri;
+    const int8_t *shift;
+    int64_t n;
+} tri_run;
+
+/* The shared state of sort_canonical's parallel passes. */
+typedef struct {
+    const tri_run *run;
+    int32_t n_nodes;
+    int64_t *start;       /* n_nodes + 1: triangles counted per first node, then where the next goes */
+    int32_t *tri;         /* the output */
+    int8_t *shift;
+    int parts;            /* node ranges of the last pass */
+} canonical_sort;
+
+/* Pass 1 of sort_canonical for one run: its triangles counted by first node. */
+static void canonical_count(void *ctx, int32_t r)
+{
+    canonical_sort *cs = ctx;
+    const tri_run *run = &cs->run[r];
+    for (int64_t t = 0; t < run->n; t++)
+        cs->start[run->tri[3 * t] + 1]++;
+}
+
+/* Pass 2 for one run: each of its triangles to the next place of its first node. */
+static void canonical_scatter(void *ctx, int32_t r)
+{
+    canonical_sort *cs = ctx;
+    const tri_run *run = &cs->run[r];
+    for (int64_t t = 0; t < run->n; t++) {
+        int64_t k = cs->start[run->tri[3 * t]]++;
+        memcpy(cs->tri + 3 * k, run->tri + 3 * t, 3 * sizeof *cs->tri);
+        memcpy(cs->shift + 6 * k, run->shift + 6 * t, 6 * sizeof *cs->shift);
+    }
+}
+
+/* Pass 3 for one range of first nodes: insertion sort of each node's few triangles by the remaining
+ * corners (start[v] now ends node v's triangles). */
+static void canonical_within(void *ctx, int32_t part)
+{
+    canonical_sort *cs = ctx;
+    int32_t v0, v1;
+    fs_parallel_part(cs->n_nodes, cs->parts, part, &v0, &v1);
+    int32_t *tri = cs->tri;
+    int8_t *shift = cs->shift;
+    int64_t t0 = v0 == 0 ? 0 : cs->start[v0 - 1], t1 = v1 == 0 ? 0 : cs->start[v1 - 1];
+    for (int64_t t = t0 + 1; t < t1; t++) {
+        for (int64_t k = t; k > t0 && tri[3 * k] == tri[3 * (k - 1)]; k--) {
+            const int32_t *a = tri + 3 * (k - 1), *b = tri + 3 * k;
+            const int8_t *sa = shift + 6 * (k - 1), *sb = shift + 6 * k;
+            bool swap = corner_less(b[1], sb + 2, a[1], sa + 2) ||
+                        (b[1] == a[1] && sb[2] == sa[2] && sb[3] == sa[3] && corner_less(b[2], sb + 4, a[2], sa + 4));
+            if (!swap)
+                break;
+            int32_t tv[3];
+            int8_t ts[6];
+            memcpy(tv, a, sizeof tv);
+            memcpy(ts, sa, sizeof ts);
+            memcpy(tri + 3 * (k - 1), b, sizeof tv);
+            memcpy(shift + 6 * (k - 1), sb, sizeof ts);
+            memcpy(tri + 3 * k, tv, sizeof tv);
+            memcpy(shift + 6 * k, ts, sizeof ts);
+        }
+    }
+}
+
 /* design: triangles are stored in a canonical order that depends only on the mesh, not on Qhull's
  * facet order nor on the blocks (below): each starts at its smallest corner (node, then shift; the
- * triangle is shifted so that corner has shift (0, 0)), and triangles are sorted by their corners
- * (counting sort on the first node, insertion sort within a node's few triangles). */
-static void canonical_order(int32_t *tri, int8_t *shift, int64_t nt, int32_t n_nodes)
+ * triangle is shifted so that corner has shift (0, 0)), and triangles are sorted by their corners:
+ * a stable counting sort on the first node over the runs in order, then an insertion sort within
+ * a node's few triangles. The runs are counted and scattered in parallel, which needs every node's
+ * triangles to come from one run (a block keeps exactly the triangles whose first node it owns):
+ * then no two runs touch one node's counter, and each node's triangles keep their order in their
+ * run, as in one pass over the runs. The node ranges of the insertion sort are independent. The
+ * result does not depend on the thread count. Writes the n_tris triangles to tri and shift. */
+static void sort_canonical(const tri_run *run, int nruns, int32_t n_nodes, int32_t *tri, int8_t *shift)
+{
+    canonical_sort cs = {run, n_nodes, fs_calloc((size_t)n_nodes + 1, sizeof *cs.start), tri, shift, 1};
+    int64_t total = 0;
+    for (int r = 0; r < nruns; r++)
+        total += run[r].n;
+    int threads = total >= CANONICAL_PARALLEL_MIN ? fs_threads() : 1;
+    fs_parallel_for(nruns, threads, canonical_count, &cs);
+    for (int32_t v = 0; v < n_nodes; v++)
+        cs.start[v + 1] += cs.start[v];
+    fs_parallel_for(nruns, threads, canonical_scatter, &cs);
+    cs.parts = threads < n_nodes ? threads : 1;
+    fs_parallel_for(cs.parts, threads, canonical_within, &cs);
+    free(cs.start);
+}
+
+/* Rotates each triangle to start at its smallest corner (node, then shift), shifted so that corner
+ * has shift (0, 0). */
+static void rotate_canonical(int32_t *tri, int8_t *shift, int64_t nt)
 {
     for (int64_t t = 0; t < nt; t++) {
         int32_t *v = tri + 3 * t;
@@ -353,38 +454,16 @@ static void canonical_order(int32_t *tri, int8_t *shift, int64_t nt, int32_t n_n
         memcpy(v, nv, sizeof nv);
         memcpy(s, ns, sizeof ns);
     }
-    int64_t *start = fs_calloc((size_t)n_nodes + 1, sizeof *start);
-    for (int64_t t = 0; t < nt; t++)
-        start[tri[3 * t] + 1]++;
-    for (int32_t v = 0; v < n_nodes; v++)
-        start[v + 1] += start[v];
+}
+
+/* Puts the triangles of one set in canonical order (see sort_canonical), in place. */
+static void canonical_order(int32_t *tri, int8_t *shift, int64_t nt, int32_t n_nodes)
+{
+    rotate_canonical(tri, shift, nt);
     int32_t *tri2 = fs_malloc((size_t)(nt ? nt : 1) * 3 * sizeof *tri2);
     int8_t *shift2 = fs_malloc((size_t)(nt ? nt : 1) * 6 * sizeof *shift2);
-    for (int64_t t = 0; t < nt; t++) {
-        int64_t k = start[tri[3 * t]]++;
-        memcpy(tri2 + 3 * k, tri + 3 * t, 3 * sizeof *tri2);
-        memcpy(shift2 + 6 * k, shift + 6 * t, 6 * sizeof *shift2);
-    }
-    free(start);
-    /* within one first node: insertion sort by the remaining corners */
-    for (int64_t t = 1; t < nt; t++) {
-        for (int64_t k = t; k > 0 && tri2[3 * k] == tri2[3 * (k - 1)]; k--) {
-            const int32_t *a = tri2 + 3 * (k - 1), *b = tri2 + 3 * k;
-            const int8_t *sa = shift2 + 6 * (k - 1), *sb = shift2 + 6 * k;
-            bool swap = corner_less(b[1], sb + 2, a[1], sa + 2) ||
-                        (b[1] == a[1] && sb[2] == sa[2] && sb[3] == sa[3] && corner_less(b[2], sb + 4, a[2], sa + 4));
-            if (!swap)
-                break;
-            int32_t tv[3];
-            int8_t ts[6];
-            memcpy(tv, a, sizeof tv);
-            memcpy(ts, sa, sizeof ts);
-            memcpy(tri2 + 3 * (k - 1), b, sizeof tv);
-            memcpy(shift2 + 6 * (k - 1), sb, sizeof ts);
-            memcpy(tri2 + 3 * k, tv, sizeof tv);
-            memcpy(shift2 + 6 * k, ts, sizeof ts);
-        }
-    }
+    tri_run run = {tri, shift, nt};
+    sort_canonical(&run, 1, n_nodes, tri2, shift2);
     memcpy(tri, tri2, (size_t)nt * 3 * sizeof *tri);
     memcpy(shift, shift2, (size_t)nt * 6 * sizeof *shift);
     free(tri2);
@@ -508,6 +587,26 @@ static double disc_half_extent(const plane_setup *s, int d, const double *c, con
     double e = c[o] < s->lo[o] ? s->lo[o] : s->hi[o];
     double half2 = (a[d] - c[d]) * (a[d] - c[d]) + (a[o] - e) * (a[o] + e - 2.0 * c[o]);
     return half2 > 0.0 ? sqrt(half2) : 0.0;
+}
+
+/* Whether the circle with centre c and squared radius r2 lies inside the region [lo, hi) as
+ * run_block's test measures it, decided without its hypot: the bound sqrt(r2) (1 + 1e-9) is at
+ * least hypot's radius whenever r2 is a normal number, rounding is monotonic, and the whole disc
+ * is what disc_half_extent measures when the centre lies in the band. Otherwise (false) the exact
+ * test decides. */
+static bool circle_surely_inside(const plane_setup *s, const double *c, double r2, const double *lo, const double *hi)
+{
+    if (!(r2 > 1e-290 && r2 < 1e290))
+        return false;
+    double half = sqrt(r2) * (1.0 + 1e-9) + s->slack;
+    for (int d = 0; d < 2; d++) {
+        int o = 1 - d;
+        if (!(s->period[o] > 0.0 || (c[o] >= s->lo[o] && c[o] <= s->hi[o])))
+            return false;
+        if (!(c[d] - half >= lo[d] && c[d] + half <= hi[d]))
+            return false;
+    }
+    return true;
 }
 
 /* The region whose points (and images) block b copies: the block widened by the margin, the whole
@@ -666,13 +765,15 @@ static void run_block(block_job *job)
                 double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
                 double ux = (cy * b2 - by * c2) / dd, uy = (bx * c2 - cx * b2) / dd;
                 double cc[2] = {pa[0] + ux, pa[1] + uy};
-                double r = hypot(ux, uy);
-                for (int d = 0; d < 2; d++) {
-                    double half = disc_half_extent(s, d, cc, pa, r) + s->slack;
-                    if (cc[d] - half < lo[d])
-                        needed = fmax(needed, job->margin + (lo[d] - (cc[d] - half)));
-                    if (cc[d] + half > hi[d])
-                        needed = fmax(needed, job->margin + (cc[d] + half - hi[d]));
+                if (!circle_surely_inside(s, cc, ux * ux + uy * uy, lo, hi)) {
+                    double r = hypot(ux, uy);
+                    for (int d = 0; d < 2; d++) {
+                        double half = disc_half_extent(s, d, cc, pa, r) + s->slack;
+                        if (cc[d] - half < lo[d])
+                            needed = fmax(needed, job->margin + (lo[d] - (cc[d] - half)));
+                        if (cc[d] + half > hi[d])
+                            needed = fmax(needed, job->margin + (cc[d] + half - hi[d]));
+                    }
                 }
             }
             const int8_t *sf = shift + 2 * (size_t)e[first];
@@ -823,18 +924,18 @@ static mesh_check triangulate_blocks(fs_mesh *m, plane_setup *s, double margin, 
         }
         return status == -1 ? MESH_ERROR : MESH_BLOCK_LIMIT;
     }
+    /* each block's triangles start at their smallest corner, with shift (0, 0), owned by the block */
     m->tri = fs_malloc((size_t)(total ? total : 1) * 3 * sizeof *m->tri);
     m->shift = fs_malloc((size_t)(total ? total : 1) * 6 * sizeof *m->shift);
-    int64_t at = 0;
+    tri_run run[MAX_BLOCKS];
+    for (int b = 0; b < nb; b++)
+        run[b] = (tri_run){jobs[b].tri, jobs[b].shift, jobs[b].n_tris};
+    sort_canonical(run, nb, m->n_nodes, m->tri, m->shift);
     for (int b = 0; b < nb; b++) {
-        memcpy(m->tri + 3 * at, jobs[b].tri, (size_t)jobs[b].n_tris * 3 * sizeof *m->tri);
-        memcpy(m->shift + 6 * at, jobs[b].shift, (size_t)jobs[b].n_tris * 6 * sizeof *m->shift);
-        at += jobs[b].n_tris;
         free(jobs[b].tri);
         free(jobs[b].shift);
     }
     m->n_tris = (int32_t)total;
-    canonical_order(m->tri, m->shift, total, m->n_nodes);
     return check_2d(m, s, unused);
 }
 

@@ -7,6 +7,7 @@
 
 #include "base/array.h"
 #include "base/error.h"
+#include "base/threads.h"
 #include "base/uf.h"
 #include "base/vec.h"
 
@@ -75,6 +76,33 @@ int32_t fs_mesh_count_boundary_edges(const fs_mesh *m)
     for (int32_t h = 0; h < 3 * m->n_tris; h++)
         count += m->adj[h] < 0;
     return count;
+}
+
+/* FNV-1a over n bytes, continuing from h. */
+static uint64_t digest_bytes(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *b = data;
+    for (size_t i = 0; b && i < n; i++)
+        h = (h ^ b[i]) * UINT64_C(0x100000001b3);
+    return h;
+}
+
+uint64_t fs_mesh_digest(const fs_mesh *m)
+{
+    size_t nt = (size_t)m->n_tris, ne = (size_t)m->n_edges;
+    uint64_t h = UINT64_C(0xcbf29ce484222325);
+    h = digest_bytes(h, m->pos, 3 * (size_t)m->n_nodes * sizeof *m->pos);
+    h = digest_bytes(h, m->tri, 3 * nt * sizeof *m->tri);
+    h = digest_bytes(h, m->shift, 6 * nt * sizeof *m->shift);
+    h = digest_bytes(h, m->adj, 3 * nt * sizeof *m->adj);
+    h = digest_bytes(h, m->edge, 2 * ne * sizeof *m->edge);
+    h = digest_bytes(h, m->edge_tri, 2 * ne * sizeof *m->edge_tri);
+    h = digest_bytes(h, m->tri_edge, 3 * nt * sizeof *m->tri_edge);
+    if (m->ring_start) {
+        h = digest_bytes(h, m->ring_start, ((size_t)m->n_nodes + 1) * sizeof *m->ring_start);
+        h = digest_bytes(h, m->ring_tri, (size_t)m->ring_start[m->n_nodes] * sizeof *m->ring_tri);
+    }
+    return h;
 }
 
 /* Half-edge h = 3 t + i runs from corner i to corner (i + 1) % 3 of triangle t: its nodes, and the
@@ -155,65 +183,39 @@ static int keyed_cmp(const void *pa, const void *pb)
     return (a->val > b->val) - (a->val < b->val);
 }
 
-/* Sorts keys (with their values, which are ascending on entry) stably: keys are
- * (node << low_bits | rest) with node < n_nodes. A counting sort on the node (one pass), then an
- * insertion sort within each node's few keys (a sort by key and value for a node of high degree,
- * which is the same order). */
-static void sort_node_keys(uint64_t *key, int32_t *val, int32_t n, int low_bits, int32_t n_nodes)
+/* Sorts the keys of each of n nodes (with their values, ascending on entry) in place, stably: the
+ * keys of node i are key[start[i] - base .. start[i + 1] - base), all with the same node in their
+ * high bits. An insertion sort of a node's few keys; a sort by key and value (the same order) for a
+ * node of high degree. */
+static void sort_node_runs(uint64_t *key, int32_t *val, const int32_t *start, int32_t n, int32_t base)
 {
-    int32_t *start = fs_calloc((size_t)n_nodes + 1, sizeof *start);
-    for (int32_t i = 0; i < n; i++)
-        start[(key[i] >> low_bits) + 1]++;
-    for (int32_t v = 0; v < n_nodes; v++)
-        start[v + 1] += start[v];
-    uint64_t *key2 = fs_malloc((size_t)(n ? n : 1) * sizeof *key2);
-    int32_t *val2 = fs_malloc((size_t)(n ? n : 1) * sizeof *val2);
-    for (int32_t i = 0; i < n; i++) {
-        int32_t k = start[key[i] >> low_bits]++;
-        key2[k] = key[i];
-        val2[k] = val[i];
-    }
-    for (int32_t v = 0, i0 = 0; v < n_nodes; v++) {
-        int32_t i1 = start[v];
+    for (int32_t v = 0; v < n; v++) {
+        int32_t i0 = start[v] - base, i1 = start[v + 1] - base;
         if (i1 - i0 > 32) {
             keyed *kv = fs_malloc((size_t)(i1 - i0) * sizeof *kv);
             for (int32_t i = i0; i < i1; i++)
-                kv[i - i0] = (keyed){key2[i], val2[i]};
+                kv[i - i0] = (keyed){key[i], val[i]};
             qsort(kv, (size_t)(i1 - i0), sizeof *kv, keyed_cmp);
             for (int32_t i = i0; i < i1; i++) {
-                key2[i] = kv[i - i0].key;
-                val2[i] = kv[i - i0].val;
+                key[i] = kv[i - i0].key;
+                val[i] = kv[i - i0].val;
             }
             free(kv);
-            i0 = i1;
             continue;
         }
         for (int32_t i = i0 + 1; i < i1; i++) {
-            uint64_t k = key2[i];
-            int32_t x = val2[i], p = i;
-            for (; p > i0 && key2[p - 1] > k; p--) {
-                key2[p] = key2[p - 1];
-                val2[p] = val2[p - 1];
+            uint64_t k = key[i];
+            int32_t x = val[i], p = i;
+            for (; p > i0 && key[p - 1] > k; p--) {
+                key[p] = key[p - 1];
+                val[p] = val[p - 1];
             }
-            key2[p] = k;
-            val2[p] = x;
+            key[p] = k;
+            val[p] = x;
         }
-        i0 = i1;
     }
-    memcpy(key, key2, (size_t)n * sizeof *key);
-    memcpy(val, val2, (size_t)n * sizeof *val);
-    free(key2);
-    free(val2);
-    free(start);
 }
 
-/* design: every half-edge gets the key (smaller node, larger node, direction); a stable sort of
- * the keys (sort_node_keys: one counting pass on the smaller node, then a node's few keys) brings
- * the two half-edges of an edge together, and a run of equal node pairs is matched by image
- * offset and direction: a partner runs the other way with the opposite offset. Runs longer than
- * two are rare: tiny periodic meshes, where one pair of nodes has several edges, or a non-manifold
- * mesh. A second half-edge along the same edge in the same direction means three triangles on one
- * edge or two facing opposite ways. */
 /* Pairs the half-edges val[0 .. n) (their adj entries -1 on entry) whose keys (see below) key[] holds,
  * sorted; shifted: the mesh has image offsets. Returns 0, or -1 with fs_error for a non-manifold
  * edge. */
@@ -282,34 +284,122 @@ static bool mesh_shifted(const fs_mesh *m)
     return false;
 }
 
+/* Below this many half-edges the whole-mesh passes run on the calling thread. */
+#define MESH_PARALLEL_MIN 300000
+/* Most parts a whole-mesh pass is cut into (each part of a counting sort has its own counters). */
+#define MESH_MAX_PARTS 8
+
+/* Parts (one per thread, at most MESH_MAX_PARTS) for a whole-mesh pass over nh half-edges. */
+static int mesh_parts(int32_t nh, int32_t n_nodes)
+{
+    int parts = nh >= MESH_PARALLEL_MIN ? fs_threads() : 1;
+    parts = parts > MESH_MAX_PARTS ? MESH_MAX_PARTS : parts;
+    return parts > n_nodes ? 1 : parts;
+}
+
+/* The shared state of fs_mesh_build_adjacency's parallel passes. */
+typedef struct {
+    fs_mesh *m;
+    int bits, parts;
+    bool shifted;
+    int32_t *count;   /* parts x (n_nodes + 1): keys per smaller node of each part's half-edges, then
+                       * where that part's next one goes */
+    int32_t *nstart;  /* n_nodes + 1: where each node's keys start */
+    uint64_t *key;    /* nh keys, sorted */
+    int32_t *val;     /* their half-edges */
+    int rc[MESH_MAX_PARTS];
+} adjacency_build;
+
+/* Pass 1, over part p of the half-edges: keys counted by smaller node. */
+static void adjacency_count(void *ctx, int32_t p)
+{
+    adjacency_build *ab = ctx;
+    const fs_mesh *m = ab->m;
+    int32_t h0, h1, *count = ab->count + (size_t)p * ((size_t)m->n_nodes + 1);
+    fs_parallel_part(3 * m->n_tris, ab->parts, p, &h0, &h1);
+    for (int32_t h = h0; h < h1; h++) {
+        count[half_edge_key(m, h, ab->bits) >> (ab->bits + 1)]++;
+        ab->m->adj[h] = -1;
+    }
+}
+
+/* Pass 2: part p's keys to their places, in half-edge order within a node (a stable sort). */
+static void adjacency_scatter(void *ctx, int32_t p)
+{
+    adjacency_build *ab = ctx;
+    const fs_mesh *m = ab->m;
+    int32_t h0, h1, *next = ab->count + (size_t)p * ((size_t)m->n_nodes + 1);
+    fs_parallel_part(3 * m->n_tris, ab->parts, p, &h0, &h1);
+    for (int32_t h = h0; h < h1; h++) {
+        uint64_t k = half_edge_key(m, h, ab->bits);
+        int32_t at = next[k >> (ab->bits + 1)]++;
+        ab->key[at] = k;
+        ab->val[at] = h;
+    }
+}
+
+/* Pass 3, over part p of the nodes: each node's keys sorted, then paired. */
+static void adjacency_pair(void *ctx, int32_t p)
+{
+    adjacency_build *ab = ctx;
+    int32_t v0, v1;
+    fs_parallel_part(ab->m->n_nodes, ab->parts, p, &v0, &v1);
+    int32_t i0 = ab->nstart[v0], i1 = ab->nstart[v1];
+    sort_node_runs(ab->key + i0, ab->val + i0, ab->nstart + v0, v1 - v0, i0);
+    ab->rc[p] = pair_sorted(ab->m, ab->key + i0, ab->val + i0, i1 - i0, ab->shifted);
+}
+
 /* design: every half-edge gets the key (smaller node, larger node, direction); a stable sort of
- * the keys (sort_node_keys: one counting pass on the smaller node, then a node's few keys) brings
+ * the keys (a counting sort on the smaller node, then a node's few keys: sort_node_runs) brings
  * the two half-edges of an edge together, and a run of equal node pairs is matched by image
  * offset and direction: a partner runs the other way with the opposite offset. Runs longer than
  * two are rare: tiny periodic meshes, where one pair of nodes has several edges, or a non-manifold
  * mesh. A second half-edge along the same edge in the same direction means three triangles on one
- * edge or two facing opposite ways. */
+ * edge or two facing opposite ways. A large mesh is done in parts on up to fs_threads() threads:
+ * the counting sort stays stable (each part counts its own half-edges, and a part's go after those
+ * of the parts before it), and a run never spans two nodes, so ranges of nodes are sorted and
+ * paired independently. The adjacency does not depend on the thread count; when a part finds a
+ * non-manifold edge, the pairing is redone in one pass, so the error reported is the first. */
 int fs_mesh_build_adjacency(fs_mesh *m)
 {
     if ((int64_t)m->n_tris * 3 > INT32_MAX) {
         fs_error(FS_ERR_DATA, "mesh: %d triangles are too many", (int)m->n_tris);
         return -1;
     }
-    int32_t nh = 3 * m->n_tris;
+    int32_t nh = 3 * m->n_tris, nn = m->n_nodes;
     free(m->adj);
     m->adj = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->adj);
-    int bits = node_bits(m);
-    uint64_t *key = fs_malloc((size_t)(nh ? nh : 1) * sizeof *key);
-    int32_t *val = fs_malloc((size_t)(nh ? nh : 1) * sizeof *val);
-    for (int32_t h = 0; h < nh; h++) {
-        key[h] = half_edge_key(m, h, bits);
-        val[h] = h;
-        m->adj[h] = -1;
+    adjacency_build ab = {.m = m, .bits = node_bits(m), .parts = mesh_parts(nh, nn), .shifted = mesh_shifted(m)};
+    ab.count = fs_calloc((size_t)ab.parts * ((size_t)nn + 1), sizeof *ab.count);
+    ab.nstart = fs_malloc(((size_t)nn + 1) * sizeof *ab.nstart);
+    ab.key = fs_malloc((size_t)(nh ? nh : 1) * sizeof *ab.key);
+    ab.val = fs_malloc((size_t)(nh ? nh : 1) * sizeof *ab.val);
+    fs_parallel_for(ab.parts, ab.parts, adjacency_count, &ab);
+    int32_t sum = 0;
+    for (int32_t v = 0; v < nn; v++) {
+        ab.nstart[v] = sum;
+        for (int p = 0; p < ab.parts; p++) {
+            int32_t *c = ab.count + (size_t)p * ((size_t)nn + 1) + v;
+            int32_t k = *c;
+            *c = sum;
+            sum += k;
+        }
     }
-    sort_node_keys(key, val, nh, bits + 1, m->n_nodes);
-    int rc = pair_sorted(m, key, val, nh, mesh_shifted(m));
-    free(key);
-    free(val);
+    ab.nstart[nn] = sum;
+    fs_parallel_for(ab.parts, ab.parts, adjacency_scatter, &ab);
+    fs_parallel_for(ab.parts, ab.parts, adjacency_pair, &ab);
+    int rc = 0;
+    for (int p = 0; p < ab.parts; p++)
+        rc = ab.rc[p] < 0 ? -1 : rc;
+    if (rc < 0 && ab.parts > 1) {
+        for (int32_t h = 0; h < nh; h++)
+            m->adj[h] = -1;
+        rc = pair_sorted(m, ab.key, ab.val, nh, ab.shifted);
+    }
+    free(ab.count);
+    free(ab.nstart);
+    free(ab.key);
+    free(ab.val);
     return rc;
 }
 
@@ -474,32 +564,61 @@ void fs_mesh_drop_derived(fs_mesh *m)
     m->n_edges = 0;
 }
 
+/* Partners of part p of the half-edges (fs_mesh_build_edges' first pass). */
+typedef struct {
+    const fs_mesh *m;
+    int parts;
+    int32_t *partner;
+} partner_pass;
+
+static void partners_of_part(void *ctx, int32_t p)
+{
+    partner_pass *pp = ctx;
+    int32_t h0, h1;
+    fs_parallel_part(3 * pp->m->n_tris, pp->parts, p, &h0, &h1);
+    for (int32_t h = h0; h < h1; h++)
+        pp->partner[h] = partner(pp->m, h);
+}
+
+/* design: edges are numbered in the order of their first half-edge. The partners, the costly part,
+ * are found first, in parallel for a large mesh (each half-edge's on its own); the numbering is one
+ * pass in half-edge order, as before, so it does not depend on the thread count. */
 void fs_mesh_build_edges(fs_mesh *m)
 {
     int32_t nh = 3 * m->n_tris;
     free(m->edge);
     free(m->edge_tri);
     free(m->tri_edge);
+    partner_pass pp = {m, mesh_parts(nh, m->n_nodes), fs_malloc((size_t)(nh ? nh : 1) * sizeof(int32_t))};
+    fs_parallel_for(pp.parts, pp.parts, partners_of_part, &pp);
     m->tri_edge = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->tri_edge);
     for (int32_t h = 0; h < nh; h++)
         m->tri_edge[h] = -1;
-    int32_t *edge = fs_malloc((size_t)(nh ? nh : 1) * 2 * sizeof *edge);
-    int32_t *edge_tri = fs_malloc((size_t)(nh ? nh : 1) * 2 * sizeof *edge_tri);
-    int32_t ne = 0;
+    /* room for the edges of a closed mesh (half as many as half-edges) and some boundary: memory
+     * of that size is often at hand, freed by the passes before, where the worst case (an edge per
+     * half-edge) would be mapped and faulted in afresh */
+    int32_t cap = nh / 2 + nh / 16 + 16, ne = 0;
+    int32_t *edge = fs_malloc((size_t)cap * 2 * sizeof *edge);
+    int32_t *edge_tri = fs_malloc((size_t)cap * 2 * sizeof *edge_tri);
     for (int32_t h = 0; h < nh; h++) {
         if (m->tri_edge[h] >= 0)
             continue;
-        half_edge e = half_edge_of(m, h);
-        edge[2 * ne] = e.from < e.to ? e.from : e.to;
-        edge[2 * ne + 1] = e.from < e.to ? e.to : e.from;
+        if (FS_ARRAY_GROW(cap, ne + 1, 16)) {
+            FS_ARRAY_RESIZE(edge, 2 * (size_t)cap);
+            FS_ARRAY_RESIZE(edge_tri, 2 * (size_t)cap);
+        }
+        int32_t a = m->tri[h], b = m->tri[3 * (h / 3) + (h % 3 + 1) % 3];
+        edge[2 * ne] = a < b ? a : b;
+        edge[2 * ne + 1] = a < b ? b : a;
         edge_tri[2 * ne] = h / 3;
         edge_tri[2 * ne + 1] = m->adj[h];
         m->tri_edge[h] = ne;
-        int32_t g = partner(m, h);
+        int32_t g = pp.partner[h];
         if (g >= 0)
             m->tri_edge[g] = ne;
         ne++;
     }
+    free(pp.partner);
     m->n_edges = ne;
     m->edge = fs_realloc(edge, (size_t)(ne ? ne : 1) * 2 * sizeof *edge);
     m->edge_tri = fs_realloc(edge_tri, (size_t)(ne ? ne : 1) * 2 * sizeof *edge_tri);
@@ -536,34 +655,51 @@ static void walk_node(const fs_mesh *m, const int32_t *corners, int32_t deg, uin
     }
 }
 
+/* The shared state of fs_mesh_build_rings' parallel pass. */
+typedef struct {
+    fs_mesh *m;
+    int parts;
+    const int32_t *start, *corner;
+    uint8_t *visited;
+    int32_t maxdeg;
+} ring_pass;
+
+/* The rings of part p of the nodes (a node's corners are its own: no two parts touch one). */
+static void rings_of_part(void *ctx, int32_t p)
+{
+    ring_pass *rp = ctx;
+    fs_mesh *m = rp->m;
+    int32_t v0, v1;
+    fs_parallel_part(m->n_nodes, rp->parts, p, &v0, &v1);
+    int32_t *order = fs_malloc((size_t)(rp->maxdeg ? rp->maxdeg : 1) * sizeof *order);
+    uint8_t *flags = fs_malloc((size_t)(rp->maxdeg ? rp->maxdeg : 1));
+    for (int32_t v = v0; v < v1; v++) {
+        int32_t s = rp->start[v], deg = rp->start[v + 1] - s;
+        walk_node(m, rp->corner + s, deg, rp->visited, order, flags);
+        m->ring_start[v] = s;
+        for (int32_t i = 0; i < deg; i++)
+            m->ring_tri[s + i] = order[i] / 3;
+    }
+    free(order);
+    free(flags);
+}
+
 void fs_mesh_build_rings(fs_mesh *m)
 {
     int32_t *start, *corner;
     node_half_edges(m, &start, &corner);
     int32_t nh = 3 * m->n_tris;
-    uint8_t *visited = fs_calloc((size_t)(nh ? nh : 1), 1);
-    int32_t maxdeg = 0;
+    ring_pass rp = {m, mesh_parts(nh, m->n_nodes), start, corner, fs_calloc((size_t)(nh ? nh : 1), 1), 0};
     for (int32_t v = 0; v < m->n_nodes; v++)
-        if (start[v + 1] - start[v] > maxdeg)
-            maxdeg = start[v + 1] - start[v];
-    int32_t *order = fs_malloc((size_t)(maxdeg ? maxdeg : 1) * sizeof *order);
-    uint8_t *flags = fs_malloc((size_t)(maxdeg ? maxdeg : 1));
-
+        if (start[v + 1] - start[v] > rp.maxdeg)
+            rp.maxdeg = start[v + 1] - start[v];
     free(m->ring_start);
     free(m->ring_tri);
     m->ring_start = fs_malloc(((size_t)m->n_nodes + 1) * sizeof *m->ring_start);
     m->ring_tri = fs_malloc((size_t)(nh ? nh : 1) * sizeof *m->ring_tri);
-    for (int32_t v = 0; v < m->n_nodes; v++) {
-        int32_t deg = start[v + 1] - start[v];
-        walk_node(m, corner + start[v], deg, visited, order, flags);
-        m->ring_start[v] = start[v];
-        for (int32_t i = 0; i < deg; i++)
-            m->ring_tri[start[v] + i] = order[i] / 3;
-    }
+    fs_parallel_for(rp.parts, rp.parts, rings_of_part, &rp);
     m->ring_start[m->n_nodes] = nh;
-    free(order);
-    free(flags);
-    free(visited);
+    free(rp.visited);
     free(start);
     free(corner);
 }

@@ -102,6 +102,11 @@ double fs_mesh_tri_area(const fs_mesh *m, int32_t t);
 /* Number of boundary edges (adj == -1). */
 int32_t fs_mesh_count_boundary_edges(const fs_mesh *m);
 
+/* A 64-bit digest (FNV-1a) of what the mesh hands on: positions, triangles (corners in order), image
+ * shifts, and the adjacency, edges and rings where they are built. Equal meshes, numbered alike,
+ * have equal digests; for tests and benchmarks that compare meshes across builds or thread counts. */
+uint64_t fs_mesh_digest(const fs_mesh *m);
+
 /* Computes the Voronoi dual. Requires edges and rings. Caller frees with fs_voronoi_free. */
 int fs_voronoi_build(const fs_mesh *m, fs_voronoi *out);
 void fs_voronoi_free(fs_voronoi *v);
