@@ -6,7 +6,9 @@
 #include <string.h>
 
 #include "base/uf.h"
+#include "geom/delaunay.h"
 #include "geom/mesh.h"
+#include "geom/sample.h"
 
 /* An nx x ny grid of unit squares, each cut by its diagonal (i, j)-(i+1, j+1) into two
  * counter-clockwise triangles: (i, j) (i+1, j) (i+1, j+1) and (i, j) (i+1, j+1) (i, j+1), square
@@ -48,6 +50,25 @@ static inline void grid_mesh(int nx, int ny, bool periodic, fs_mesh *m)
                 }
             }
     fs_mesh_build_adjacency(m);
+}
+
+/* A periodic w x w cm tile of about `points` nodes, Poisson-disk sampled with the seed and meshed.
+ * Returns 0, or -1 with fs_error. */
+static inline int sampled_tile(double w, int32_t points, uint64_t seed, fs_mesh *m)
+{
+    fs_domain d = fs_domain_default();
+    d.width = d.height = w;
+    d.periodic_x = d.periodic_y = true;
+    fs_domain_normalize(&d);
+    fs_sample_params sp = fs_sample_params_default();
+    sp.count = points;
+    sp.seed = seed;
+    fs_points pts = {0};
+    if (fs_sample_repulsion(&d, &sp, &pts) < 0)
+        return -1;
+    int rc = fs_delaunay(&d, &pts, m);
+    fs_points_free(&pts);
+    return rc;
 }
 
 /* Undirected edges: the half-edges joined in pairs, plus the boundary ones. */

@@ -6,28 +6,9 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "check.h"
-#include "geom/delaunay.h"
-#include "geom/sample.h"
+#include "mesh_fixture.h"
 #include "model/model.h"
 #include "sim/sim.h"
-
-/* A 4 x 4 cm periodic tile of about `points` nodes. */
-static int tiny_mesh(int32_t points, fs_mesh *m)
-{
-    fs_domain d = fs_domain_default();
-    d.width = d.height = 4.0;
-    d.periodic_x = d.periodic_y = true;
-    fs_domain_normalize(&d);
-    fs_sample_params sp = fs_sample_params_default();
-    sp.count = points;
-    sp.seed = 5;
-    fs_points pts = {0};
-    if (fs_sample_repulsion(&d, &sp, &pts) < 0)
-        return -1;
-    int rc = fs_delaunay(&d, &pts, m);
-    fs_points_free(&pts);
-    return rc;
-}
 
 /* A thin layer that shrinks on top while its bottom holds: it must crack, whatever the model. */
 static fs_model_setup shrinking_layer(fs_model_kind kind)
@@ -70,7 +51,7 @@ static void check_surface(const fs_surface *s, const char *what)
 static void test_voronoi(void)
 {
     fs_mesh m = {0};
-    CHECK(tiny_mesh(60, &m) == 0);
+    CHECK(sampled_tile(4.0, 60, 5, &m) == 0);
     fs_model_setup s = fs_model_setup_default();
     fs_model model;
     CHECK(fs_model_init(&model, &m, &s) == 0);
@@ -97,7 +78,7 @@ static void run_physical(fs_model_kind kind, fs_fracture_method method)
 {
     const char *name = fs_model_name(kind);
     fs_mesh m = {0};
-    CHECK(tiny_mesh(kind == FS_MODEL_SPRINGS ? 300 : 150, &m) == 0);
+    CHECK(sampled_tile(4.0, kind == FS_MODEL_SPRINGS ? 300 : 150, 5, &m) == 0);
     fs_model_setup s = shrinking_layer(kind);
     s.fracture.method = method;
     fs_model model;
@@ -136,7 +117,7 @@ static void test_shell(void) { run_physical(FS_MODEL_SHELL, FS_FRACTURE_SPLIT); 
 static void test_refusals(void)
 {
     fs_mesh m = {0};
-    CHECK(tiny_mesh(60, &m) == 0);
+    CHECK(sampled_tile(4.0, 60, 5, &m) == 0);
     {
         fs_model_setup s = shrinking_layer(FS_MODEL_WEDGE);
         s.kind = (fs_model_kind)99;

@@ -7,29 +7,10 @@
 #include "base/error.h"
 #include "base/vec.h"
 #include "check.h"
-#include "geom/delaunay.h"
-#include "geom/sample.h"
+#include "mesh_fixture.h"
 #include "geom/uvmesh.h"
 #include "model/model.h"
 #include "model/shell/internal.h"
-
-/* A periodic w x w cm tile of about `points` nodes sampled with the seed. */
-static int tile(double w, int32_t points, uint64_t seed, fs_mesh *m)
-{
-    fs_domain d = fs_domain_default();
-    d.width = d.height = w;
-    d.periodic_x = d.periodic_y = true;
-    fs_domain_normalize(&d);
-    fs_sample_params sp = fs_sample_params_default();
-    sp.count = points;
-    sp.seed = seed;
-    fs_points pts = {0};
-    if (fs_sample_repulsion(&d, &sp, &pts) < 0)
-        return -1;
-    int rc = fs_delaunay(&d, &pts, m);
-    fs_points_free(&pts);
-    return rc;
-}
 
 /* A layer E = 10 MPa, nu = 0.3, threshold 100 kPa, h cm thick, bonded (shell) or on its bottom (wedge). */
 static fs_model_setup layer(fs_model_kind kind, double h)
@@ -68,7 +49,7 @@ static int32_t crack_walls(const fs_shell *s, int32_t *walls)
 static void test_tension_cracks_across(void)
 {
     fs_mesh m = {0};
-    CHECK(tile(4.0, 600, 3, &m) == 0);
+    CHECK(sampled_tile(4.0, 600, 3, &m) == 0);
     fs_model_setup s = layer(FS_MODEL_SHELL, 0.2);
     s.growth.type = FS_GROWTH_PLANAR;
     s.growth.r1 = 0.03;
