@@ -57,4 +57,54 @@ if [ "${2:-0}" -ge 10 ] && awk_true "${3:-0} / ${2:-1} >= ${6:-0} / ${5:-1} - 0.
 else
     not_ok "cracks continue across UV seams (got '$3' of '$2' runs on seams; '$6' of '$5' elsewhere)"
 fi
+# The same thin layer (0.25 cm, E 10 MPa, threshold 100 kPa, shrinking 3 % through its thickness on a
+# periodic 3 x 3 cm tile, 2250 triangles) as a bonded shell and as a wedge layer held at its bottom:
+# their crack spacings (2 area / crack length, from the crack graphs) within 30 % of each other.
+layer_preset() {
+    cat >"$tmp/layer-$1.ini" <<INI
+[preset]
+name = layer
+model = $1
+seed = 4
+[domain]
+type = plane
+width = 3
+height = 3
+periodic = xy
+[mesh]
+elements = 2250
+min_size = 2
+[material]
+young = 10
+poisson = 0.3
+threshold = 100
+thickness = 0.25
+jitter = 0.1
+[shrink]
+top = 0:0, 1:0.03
+bottom = 0:0, 1:0.03
+[fracture]
+method = split
+griffith = false
+[time]
+end = 1
+min_step = 0.01
+[render]
+size = 384x384
+INI
+}
+spacing() { # crack graph, tile width in cm: 2 A / L
+    sed -n 's/.*"total_length_px": *\([0-9.]*\).*/\1/p' "$1" | awk -v w="$2" '{ if ($1 > 0) printf "%.3f", 2 * w / ($1 / 384) }'
+}
+for model in wedge shell; do
+    layer_preset $model
+    expect_status 0 "a thin layer as $model runs" "$FISSURE" -q -o "$tmp/layer-$model" "$tmp/layer-$model.ini"
+done
+s_wedge=$(spacing "$tmp/layer-wedge/layer_cracks.json" 3)
+s_shell=$(spacing "$tmp/layer-shell/layer_cracks.json" 3)
+if [ -n "$s_wedge" ] && [ -n "$s_shell" ] && awk_true "$s_shell > 0.7 * $s_wedge && $s_shell < $s_wedge / 0.7"; then
+    ok "shell and wedge crack spacing within 30 % (shell $s_shell cm, wedge $s_wedge cm)"
+else
+    not_ok "shell and wedge crack spacing within 30 % (shell '$s_shell' cm, wedge '$s_wedge' cm)"
+fi
 finish

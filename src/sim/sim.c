@@ -16,9 +16,10 @@
 /* Points for the mesh: particle repulsion, or the hexagonal lattice. */
 static int sample_points(const fs_config *cfg, fs_points *pts)
 {
-    /* the wedge model counts triangles (wedges), the tet model those of its top surface: a Delaunay
-     * mesh has about two per point */
-    bool triangles = cfg->preset.model == FS_MODEL_WEDGE || cfg->preset.model == FS_MODEL_TET;
+    /* the wedge and shell models count triangles (wedges, faces), the tet model those of its top
+     * surface: a Delaunay mesh has about two per point */
+    bool triangles = cfg->preset.model == FS_MODEL_WEDGE || cfg->preset.model == FS_MODEL_TET ||
+                     cfg->preset.model == FS_MODEL_SHELL;
     int32_t count = triangles ? cfg->mesh.elements / 2 : cfg->mesh.elements;
     if (cfg->mesh.lattice == FS_LATTICE_HEX)
         return fs_sample_hex(&cfg->domain, count, pts);

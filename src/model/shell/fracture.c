@@ -18,7 +18,32 @@
  * z = +-h/2 of the elastic strains (E / (1 - nu^2) ((1 - nu) e + nu tr(e) I)) over the face's
  * threshold stress: tension only, the same measure the wedge model compares (the principal strain
  * of the paper times the plane-stress modulus, up to the nu coupling). The crack's plane is normal
- * to that principal direction. */
+ * to that principal direction.
+ *
+ * A bonded shell: the bond pulls on the layer's bottom face, so the layer shears through its
+ * thickness and its faces do not strain alike. The bond's stiffness (shell.c: 2G/h per unit area
+ * times [shell] bond b) is that of the lower half of the layer sheared uniformly, through the
+ * half-thickness, from the surface's point to the middle surface's (b = 1: a bottom face held to the
+ * surface; b < 1: a softer surface takes 1 - b of the shear). The same uniform shear carries on to
+ * the free top face, whose displacement is then the middle surface's plus b times the middle
+ * surface's displacement from the surface below, and whose membrane strain is
+ *     Em + b (Em(x) - Em(anchors))            (b at most 1),
+ * as in a wedge layer (linear through its thickness) on its bottom. Near a crack, where the middle
+ * surface shrinks back from its anchors, the top face is relieved twice as much as the middle
+ * (for b = 1): this is what spaces the cracks of a thin bonded layer at the wedge model's spacing
+ * (tests/cli_shell.sh compares the two). The bottom face of a bonded shell is held by its bond, as
+ * the wedge and tet models' bottoms are, and is not read; a free shell (b = 0) reads both faces. */
+
+/* The bond's shear of the membrane strain of face t at the current positions (fracture.c design):
+ * Em(x) - Em(anchors), in the face's frame. */
+static void bond_shear(const fs_shell *s, int32_t t, double d[3])
+{
+    double ex[3], ea[3], unused[3];
+    fs_shell_strains(s, s->x, t, ex, unused);
+    fs_shell_strains(s, s->anchor, t, ea, unused);
+    for (int k = 0; k < 3; k++)
+        d[k] = ex[k] - ea[k];
+}
 
 double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2])
 {
@@ -26,8 +51,15 @@ double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2])
     fs_shell_elastic_strains(s, s->x, t, em, ec);
     double h = fs_shell_tri_thickness(s, t), nu = s->cfg.material.poisson;
     double c = s->young[t] / (1.0 - nu * nu);
+    double bond = fmin(s->cfg.shell.bond, 1.0);
+    if (bond > 0.0) {
+        double d[3];
+        bond_shear(s, t, d);
+        for (int k = 0; k < 3; k++)
+            em[k] += bond * d[k];
+    }
     double best = -INFINITY, dir[2] = {1.0, 0.0};
-    for (int side = -1; side <= 1; side += 2) {
+    for (int side = bond > 0.0 ? 1 : -1; side <= 1; side += 2) {
         double z = 0.5 * h * side;
         double e[3] = {em[0] + z * ec[0], em[1] + z * ec[1], em[2] + z * ec[2]};
         double tr = e[0] + e[1];
@@ -178,7 +210,7 @@ int fs_shell_advance(fs_shell *s, double t_end)
         /* the cascade at this time: cut and relax around the cut until nothing is over its threshold
          * (the local relaxations leave residuals below solver.relax_tolerance of a crack's force; the
          * next time step solves the whole shell) */
-        for (int64_t events = 0; events < MAX_EVENTS_AT_ONCE && fs_shell_max_ratio(s, NULL) > 1.0;) {
+        for (int64_t events = 0; events < MAX_EVENTS_AT_ONCE;) {
             double t0 = fs_seconds();
             int32_t *seeds = NULL, n_seeds = 0;
             int32_t cuts = fs_shell_fracture_batch(s, &seeds, &n_seeds);
@@ -191,7 +223,7 @@ int fs_shell_advance(fs_shell *s, double t_end)
                 goto done;
             }
             if (cuts == 0)
-                break; /* nothing could be cut: let time move on */
+                break; /* nothing over its threshold, or nothing could be cut: let time move on */
             events += cuts;
             if (plastic_steps(s) < 0) {
                 rc = -1;

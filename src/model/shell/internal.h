@@ -86,6 +86,15 @@ typedef struct {
 /* Releases a system's arrays and factor and zeroes it. */
 void fs_shell_system_free(fs_shell_system *sys);
 
+/* Scratch of the local relaxations (shell/relax.c), kept across them: dof is -1 and in 0 between
+ * uses, so a relaxation touches only its own nodes and triangles. */
+typedef struct {
+    int32_t *dof;                  /* 3 per node (cap_nodes): a local system's unknowns */
+    uint8_t *in;                   /* per triangle (cap_tris): in the scope being built */
+    int32_t *tris;                 /* per triangle: the scope's triangles */
+    int32_t cap_nodes, cap_tris;
+} fs_shell_local;
+
 struct fs_shell {
     fs_mesh *mesh;                 /* borrowed; fracture cuts it in place */
     fs_model_setup cfg;            /* copy of the setup (the pointers in it are borrowed) */
@@ -154,6 +163,7 @@ struct fs_shell {
     double *grad;                  /* 3 per node: gradient of the energy at x */
     double *work;                  /* scratch: 2 n_free + 6 n_nodes (reallocated to fit) */
     size_t work_size;
+    fs_shell_local local;          /* scratch of the local relaxations */
     fs_sparse_builder pattern;     /* scratch of every Hessian pattern built (the whole shell's after
                                       each cut, each local region's): its arrays are reused */
 

@@ -398,6 +398,9 @@ void fs_shell_destroy(fs_shell *s)
     free(s->phi);
     free(s->dphi);
     free(s->work);
+    free(s->local.dof);
+    free(s->local.in);
+    free(s->local.tris);
     fs_sparse_builder_free(&s->pattern);
     fs_shell_system_free(&s->sys);
     free(s);

@@ -56,7 +56,8 @@ static int factorize(fs_shell *s, fs_shell_system *sys)
 {
     double t0 = fs_seconds();
     if (!sys->chol) {
-        sys->chol = fs_cholesky_analyze(&sys->K);
+        /* a local relaxation's system is factored a few times: AMD alone, simplicial */
+        sys->chol = sys == &s->sys ? fs_cholesky_analyze(&sys->K) : fs_cholesky_analyze_small(&sys->K);
         s->counters.analyses++;
         if (!sys->chol)
             return -1;
