@@ -401,19 +401,26 @@ static void apply_blas_threads(void)
         set_threads(1);
 }
 
-static fs_cholesky *analyze(const fs_sparse_matrix *a, bool small);
+typedef enum { ANALYZE_BEST, ANALYZE_AMD, ANALYZE_SMALL } analyze_mode;
+
+static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode);
 
 fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a)
 {
-    return analyze(a, false);
+    return analyze(a, ANALYZE_BEST);
+}
+
+fs_cholesky *fs_cholesky_analyze_amd(const fs_sparse_matrix *a)
+{
+    return analyze(a, ANALYZE_AMD);
 }
 
 fs_cholesky *fs_cholesky_analyze_small(const fs_sparse_matrix *a)
 {
-    return analyze(a, true);
+    return analyze(a, ANALYZE_SMALL);
 }
 
-static fs_cholesky *analyze(const fs_sparse_matrix *a, bool small)
+static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode)
 {
     apply_blas_threads();
     fs_cholesky *c = fs_calloc(1, sizeof *c);
@@ -435,11 +442,12 @@ static fs_cholesky *analyze(const fs_sparse_matrix *a, bool small)
      * elimination tree, whose short paths make the rank updates after removals ~30 % cheaper
      * (bench_wedge), for a few tens of ms more per analysis. */
     c->common.nmethods = 3;
-    if (small) {
-        /* fs_cholesky_analyze_small: AMD alone, and a simplicial factor (no BLAS calls) */
+    if (mode != ANALYZE_BEST) {
+        /* fs_cholesky_analyze_amd: AMD alone; _small: and a simplicial factor (no BLAS calls) */
         c->common.nmethods = 1;
         c->common.method[0].ordering = CHOLMOD_AMD;
-        c->common.supernodal = CHOLMOD_SIMPLICIAL;
+        if (mode == ANALYZE_SMALL)
+            c->common.supernodal = CHOLMOD_SIMPLICIAL;
     }
     c->n = a->n;
     c->nnz = fs_sparse_matrix_nnz(a);

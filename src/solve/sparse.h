@@ -123,6 +123,11 @@ fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a);
  * work to the BLAS's threads and back. Results as fs_cholesky_analyze's up to rounding. */
 fs_cholesky *fs_cholesky_analyze_small(const fs_sparse_matrix *a);
 
+/* fs_cholesky_analyze with AMD alone (no METIS), the factor supernodal or simplicial as CHOLMOD
+ * chooses: for a large system whose pattern changes often, so that each analysis serves only a few
+ * factorizations (the shell model's, re-analysed after every cascade of cuts). */
+fs_cholesky *fs_cholesky_analyze_amd(const fs_sparse_matrix *a);
+
 /* Numerically factorizes a with its current values. a must have the pattern given to
  * fs_cholesky_analyze (same n and entry count are checked with FS_ASSERT; the pattern itself is the
  * caller's contract). Call again after rewriting a->values to refactorize cheaply: the ordering and the

@@ -514,6 +514,19 @@ static void take_before(fs_shell *s, face_cut *fc)
     fc->taken = true;
 }
 
+/* The rest geometry the next ray of the same cut reads in v0's fan: the new nodes' positions and the
+ * new faces' frames (a face split off lies in its parent's plane). apply_cut brings the rest up to
+ * date once the cut is whole. */
+static void cut_geometry(fs_shell *s, const fs_cut *c)
+{
+    const fs_mesh *m = s->mesh;
+    fs_shell_reserve(s, m->n_nodes, m->n_tris);
+    new_nodes(s, c);
+    for (int32_t t = c->n_tris_before; t < m->n_tris; t++)
+        memcpy(s->frame + 6 * (size_t)t, s->frame + 6 * (size_t)c->tri_parent[t - c->n_tris_before],
+               6 * sizeof *s->frame);
+}
+
 /* The end of the ray from v0 that hit h: the split point of the hit edge, or its near end (budged
  * onto the ray when it may move, and only while the mesh is as the state knows it). Returns the end
  * node, or -1 with fs_error. */
@@ -525,7 +538,10 @@ static int32_t ray_end(fs_shell *s, face_cut *fc, const ray_hit *h)
     if (h->kind == FS_SPLIT_EDGE) {
         take_before(s, fc);
         int32_t p = fs_cut_split_edge(c, h->tri, ia, h->s);
-        return fs_cut_update_adjacency(c) < 0 ? -1 : p;
+        if (fs_cut_update_adjacency(c) < 0)
+            return -1;
+        cut_geometry(s, c);
+        return p;
     }
     int32_t w = m->tri[3 * (size_t)h->tri + (h->kind == FS_SPLIT_AT_A ? ia : (ia + 1) % 3)];
     int32_t n = fan_of(c, w, &fc->fan, &fc->cap);

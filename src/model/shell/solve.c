@@ -56,8 +56,9 @@ static int factorize(fs_shell *s, fs_shell_system *sys)
 {
     double t0 = fs_seconds();
     if (!sys->chol) {
-        /* a local relaxation's system is factored a few times: AMD alone, simplicial */
-        sys->chol = sys == &s->sys ? fs_cholesky_analyze(&sys->K) : fs_cholesky_analyze_small(&sys->K);
+        /* every pattern serves only a few factorizations (the mesh changes with each cascade): AMD
+         * alone, and for a local relaxation's small system a simplicial factor */
+        sys->chol = sys == &s->sys ? fs_cholesky_analyze_amd(&sys->K) : fs_cholesky_analyze_small(&sys->K);
         s->counters.analyses++;
         if (!sys->chol)
             return -1;
