@@ -107,4 +107,18 @@ if [ -n "$s_wedge" ] && [ -n "$s_shell" ] && awk_true "$s_shell > 0.7 * $s_wedge
 else
     not_ok "shell and wedge crack spacing within 30 % (shell '$s_shell' cm, wedge '$s_wedge' cm)"
 fi
+# The same shell yielding at 70 kPa, below its 100 kPa threshold: plastic flow relieves the stress, so
+# fewer cracks open, further apart (as paint's coat; seed 4: 0.59 cm against 0.43).
+expect_status 0 "a plastic thin layer runs" "$FISSURE" -q -o "$tmp/layer-plastic" --set shell.yield=70 \
+    "$tmp/layer-shell.ini"
+s_plastic=$(spacing "$tmp/layer-plastic/layer_cracks.json" 3)
+fractures() { sed -n 's/.*"fractures": *\([0-9]*\).*/\1/p' "$1" | head -1; }
+f_shell=$(fractures "$tmp/layer-shell/layer.json")
+f_plastic=$(fractures "$tmp/layer-plastic/layer.json")
+if [ -n "$s_plastic" ] && [ -n "$s_shell" ] && [ "${f_plastic:-0}" -gt 0 ] && [ "${f_plastic:-0}" -lt "${f_shell:-0}" ] &&
+    awk_true "$s_plastic > 1.15 * $s_shell"; then
+    ok "yielding widens the crack spacing (plastic $s_plastic cm, $f_plastic fractures; brittle $s_shell cm, $f_shell)"
+else
+    not_ok "yielding widens the crack spacing (plastic '$s_plastic' cm, '$f_plastic' fractures; brittle '$s_shell' cm, '$f_shell')"
+fi
 finish

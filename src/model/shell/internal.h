@@ -293,8 +293,9 @@ int fs_shell_relax(fs_shell *s, const int32_t *seeds, int32_t n_seeds);
 
 /* The plastic update of every triangle at the current state (Gingold et al. §"Plasticity", derived):
  * where the yield function is positive, the plastic strain moves along the flow direction until it is
- * zero. Returns the number of triangles updated. */
-int32_t fs_shell_plastic_update(fs_shell *s);
+ * zero. Returns the number of triangles updated; *excess (when not NULL) gets the largest relative
+ * amount by which one was over yield (the yield function over eps0), 0 when none was. */
+int32_t fs_shell_plastic_update(fs_shell *s, double *excess);
 
 /* ---- surface.c ---- */
 

@@ -54,9 +54,11 @@ static tensor3 response(const tensor3 *n, double gamma, double c1, double c2)
     return d;
 }
 
-int32_t fs_shell_plastic_update(fs_shell *s)
+int32_t fs_shell_plastic_update(fs_shell *s, double *excess)
 {
     double yield = 1e-3 * s->cfg.shell.yield; /* MPa */
+    if (excess)
+        *excess = 0.0;
     if (!(yield > 0.0))
         return 0;
     double nu = s->cfg.material.poisson, gamma = s->cfg.shell.hardening;
@@ -75,6 +77,8 @@ int32_t fs_shell_plastic_update(fs_shell *s)
         double f2 = norm2(&xm) + norm2(&xc), f = sqrt(f2);
         if (!(f > eps0 * (1.0 + 1e-9)))
             continue;
+        if (excess && f / eps0 - 1.0 > *excess)
+            *excess = f / eps0 - 1.0;
         tensor3 nm = {{xm.in[0] / f, xm.in[1] / f, xm.in[2] / f}, xm.zz / f};
         tensor3 nc = {{xc.in[0] / f, xc.in[1] / f, xc.in[2] / f}, xc.zz / f};
         tensor3 dm = response(&nm, gamma, c1, c2), dc = response(&nc, gamma, c1, c2);
