@@ -242,6 +242,51 @@ static void test_builder_reused(void)
     fs_sparse_builder_free(&reused);
 }
 
+/* Random entries, some columns holding more distinct rows than a small sort handles: every column's
+ * rows strictly increasing with its diagonal, every value the sum of its pair's entries in entry
+ * order (against a dense sum made in the same order, bit for bit), every slot at its pair. */
+static void test_builder_random_columns(void)
+{
+    const int32_t n = 120;
+    const size_t count = 6000;
+    fs_sparse_builder b;
+    fs_sparse_builder_init(&b, n, 0);
+    double *dense = calloc((size_t)n * n, sizeof *dense);
+    int32_t *rows = malloc(count * sizeof *rows), *cols = malloc(count * sizeof *cols);
+    for (size_t e = 0; e < count; e++) {
+        /* column 7 and the last ten collect many rows */
+        int32_t c = e % 3 == 0 ? (e % 2 ? 7 : n - 1 - (int32_t)(e % 10))
+                               : (int32_t)(fs_rand01(5, FS_RNG_TEST, 2 * e) * n);
+        int32_t r = (int32_t)(fs_rand01(5, FS_RNG_TEST, 2 * e + 1) * n);
+        double v = fs_rand_range(5, FS_RNG_TEST, 1000000 + e, -1.0, 1.0);
+        fs_sparse_builder_add(&b, r, c, v);
+        rows[e] = r < c ? r : c;
+        cols[e] = r < c ? c : r;
+        dense[(size_t)cols[e] * n + rows[e]] += v;
+    }
+    int32_t *slots = malloc(count * sizeof *slots);
+    fs_sparse_matrix m;
+    CHECK(fs_sparse_builder_compress(&b, &m, slots) == 0);
+    int bad = 0, wide = 0;
+    for (int32_t j = 0; j < n; j++) {
+        wide += m.col_ptr[j + 1] - m.col_ptr[j] > 48;
+        bad += m.row_idx[m.col_ptr[j + 1] - 1] != j;
+        for (int32_t p = m.col_ptr[j]; p < m.col_ptr[j + 1]; p++) {
+            bad += p > m.col_ptr[j] && m.row_idx[p] <= m.row_idx[p - 1];
+            bad += m.values[p] != dense[(size_t)j * n + m.row_idx[p]];
+        }
+    }
+    for (size_t e = 0; e < count; e++)
+        bad += slots[e] < m.col_ptr[cols[e]] || slots[e] >= m.col_ptr[cols[e] + 1] || m.row_idx[slots[e]] != rows[e];
+    CHECK_MSG(bad == 0 && wide > 0, "%d wrong entries or slots (%d columns past a small sort)", bad, wide);
+    fs_sparse_matrix_free(&m);
+    fs_sparse_builder_free(&b);
+    free(dense);
+    free(rows);
+    free(cols);
+    free(slots);
+}
+
 static void test_matvec_matches_dense(void)
 {
     enum { n = 7 };
@@ -1067,6 +1112,7 @@ int main(void)
 {
     RUN(test_builder_sums_duplicates);
     RUN(test_builder_reused);
+    RUN(test_builder_random_columns);
     RUN(test_matvec_matches_dense);
     RUN(test_principal_submatrix);
     RUN(test_slots_reproduce_fresh_assembly);

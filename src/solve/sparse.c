@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cholmod.h>
@@ -83,29 +84,75 @@ int32_t fs_sparse_builder_add_block(fs_sparse_builder *b, int32_t k, const int32
     return added;
 }
 
-/* design: two stable counting sorts, by row and then by column, leave each column's entries in increasing
- * row order with the entries of one (row, column) pair in entry order; merging runs of equal rows then
- * sums duplicates in entry order, which fs_sparse_matrix_add_block repeats exactly. O(n + count). */
+/* An entry bucketed into its column, with what compression reads of it. */
+typedef struct {
+    double value;
+    int32_t row;
+    uint32_t entry;
+} column_entry;
+
+/* The distinct rows of one column's entries, and the diagonal j, into list (marking each with j in
+ * mark). Returns how many. */
+static int32_t column_rows(const column_entry *col, size_t k, int32_t j, int32_t *mark, int32_t *list)
+{
+    int32_t u = 0;
+    for (size_t q = 0; q < k; q++) {
+        int32_t r = col[q].row;
+        if (mark[r] != j) {
+            mark[r] = j;
+            list[u++] = r;
+        }
+    }
+    if (mark[j] != j) {
+        mark[j] = j;
+        list[u++] = j;
+    }
+    return u;
+}
+
+static int compare_int32(const void *a, const void *b)
+{
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return (x > y) - (x < y);
+}
+
+static void sort_rows(int32_t *list, int32_t u)
+{
+    if (u > 48) {
+        qsort(list, (size_t)u, sizeof *list, compare_int32);
+        return;
+    }
+    for (int32_t i = 1; i < u; i++) {
+        int32_t v = list[i], k = i;
+        for (; k > 0 && list[k - 1] > v; k--)
+            list[k] = list[k - 1];
+        list[k] = v;
+    }
+}
+
+/* design: one stable counting sort buckets the entries by column, carrying each entry's row and value
+ * along so that the columns are then read in sequence; a column's distinct rows are marked, sorted (a
+ * column holds a few dozen) and numbered, and its entries summed into them in entry order, which
+ * fs_sparse_matrix_add_block repeats exactly. O(n + count) plus the columns' small sorts. */
 int fs_sparse_builder_compress(fs_sparse_builder *b, fs_sparse_matrix *out, int32_t *slots)
 {
     int32_t n = b->n;
     size_t count = b->count;
-    size_t need = 2 * ((size_t)n + 1) + 2 * count;
+    if (count > UINT32_MAX) {
+        fs_error(FS_ERR_INTERNAL, "sparse: %zu entries exceed the 32-bit entry numbers", count);
+        return -1;
+    }
+    size_t bytes = 2 * ((size_t)n + 1) * sizeof(size_t) + count * sizeof(column_entry) +
+                   3 * ((size_t)n + 1) * sizeof(int32_t);
+    size_t need = (bytes + sizeof(size_t) - 1) / sizeof(size_t);
     if (need > b->scratch_size) {
         free(b->scratch);
         b->scratch = fs_malloc(need * sizeof *b->scratch);
         b->scratch_size = need;
     }
-    size_t *start = b->scratch, *cursor = start + (size_t)n + 1, *by_row = cursor + (size_t)n + 1,
-           *order = by_row + count;
-    memset(start, 0, ((size_t)n + 1) * sizeof *start);
-
-    for (size_t e = 0; e < count; e++)
-        start[b->rows[e] + 1]++;
-    for (int32_t i = 0; i < n; i++)
-        start[i + 1] += start[i];
-    for (size_t e = 0; e < count; e++)
-        by_row[start[b->rows[e]]++] = e;
+    size_t *start = b->scratch, *cursor = start + (size_t)n + 1;
+    column_entry *bucket = (column_entry *)(cursor + (size_t)n + 1);
+    int32_t *mark = (int32_t *)(bucket + count), *pos = mark + (size_t)n + 1, *list = pos + (size_t)n + 1;
 
     memset(start, 0, ((size_t)n + 1) * sizeof *start);
     for (size_t e = 0; e < count; e++)
@@ -113,23 +160,14 @@ int fs_sparse_builder_compress(fs_sparse_builder *b, fs_sparse_matrix *out, int3
     for (int32_t j = 0; j < n; j++)
         start[j + 1] += start[j];
     memcpy(cursor, start, ((size_t)n + 1) * sizeof *cursor);
-    for (size_t k = 0; k < count; k++) {
-        size_t e = by_row[k];
-        order[cursor[b->cols[e]]++] = e;
-    }
+    for (size_t e = 0; e < count; e++)
+        bucket[cursor[b->cols[e]]++] = (column_entry){b->values[e], b->rows[e], (uint32_t)e};
 
     size_t nnz = 0;
-    for (int32_t j = 0; j < n; j++) {
-        int32_t last = -1;
-        for (size_t k = start[j]; k < start[j + 1]; k++) {
-            int32_t r = b->rows[order[k]];
-            if (r != last)
-                nnz++;
-            last = r;
-        }
-        if (last != j)
-            nnz++;
-    }
+    for (int32_t i = 0; i < n; i++)
+        mark[i] = -1;
+    for (int32_t j = 0; j < n; j++)
+        nnz += (size_t)column_rows(bucket + start[j], start[j + 1] - start[j], j, mark, list);
     if (nnz > (size_t)INT32_MAX) {
         fs_error(FS_ERR_INTERNAL, "sparse: %zu stored entries exceed the 32-bit index range", nnz);
         return -1;
@@ -139,28 +177,27 @@ int fs_sparse_builder_compress(fs_sparse_builder *b, fs_sparse_matrix *out, int3
     out->col_ptr = fs_malloc(((size_t)n + 1) * sizeof *out->col_ptr);
     out->row_idx = fs_malloc(nnz * sizeof *out->row_idx);
     out->values = fs_malloc(nnz * sizeof *out->values);
+    for (int32_t i = 0; i < n; i++)
+        mark[i] = -1;
     int32_t p = 0;
     for (int32_t j = 0; j < n; j++) {
+        const column_entry *col = bucket + start[j];
+        size_t k = start[j + 1] - start[j];
+        int32_t u = column_rows(col, k, j, mark, list);
+        sort_rows(list, u);
         out->col_ptr[j] = p;
-        int32_t last = -1;
-        for (size_t k = start[j]; k < start[j + 1]; k++) {
-            size_t e = order[k];
-            int32_t r = b->rows[e];
-            if (r != last) {
-                out->row_idx[p] = r;
-                out->values[p] = 0.0;
-                p++;
-                last = r;
-            }
-            out->values[p - 1] += b->values[e];
+        for (int32_t q = 0; q < u; q++) {
+            pos[list[q]] = p + q;
+            out->row_idx[p + q] = list[q];
+            out->values[p + q] = 0.0;
+        }
+        for (size_t q = 0; q < k; q++) {
+            int32_t at = pos[col[q].row];
+            out->values[at] += col[q].value;
             if (slots)
-                slots[e] = p - 1;
+                slots[col[q].entry] = at;
         }
-        if (last != j) {
-            out->row_idx[p] = j;
-            out->values[p] = 0.0;
-            p++;
-        }
+        p += u;
     }
     out->col_ptr[n] = p;
     return 0;
