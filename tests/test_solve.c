@@ -1108,6 +1108,30 @@ static void test_cholesky_independent_of_blas_threads(void)
     fs_sparse_matrix_free(&a);
 }
 
+/* CHOLMOD's OpenMP regions run on the calling thread once an analysis has been made (when the
+ * process has OpenMP at all: Debian's CHOLMOD brings libgomp). */
+static void test_cholesky_openmp_regions_serial(void)
+{
+    int (*get_levels)(void) = NULL;
+    *(void **)(&get_levels) = dlsym(RTLD_DEFAULT, "omp_get_max_active_levels");
+    if (!get_levels) {
+        printf("skip: no OpenMP in the process\n");
+        return;
+    }
+    fs_sparse_builder bld;
+    fs_sparse_builder_init(&bld, 2, 0);
+    fs_sparse_builder_add(&bld, 0, 0, 2.0);
+    fs_sparse_builder_add(&bld, 1, 1, 2.0);
+    fs_sparse_matrix a;
+    CHECK(fs_sparse_builder_compress(&bld, &a, NULL) == 0);
+    fs_cholesky *c = fs_cholesky_analyze(&a);
+    CHECK(c != NULL);
+    CHECK_MSG(get_levels() == 0, "OpenMP max active levels %d after an analysis", get_levels());
+    fs_cholesky_free(c);
+    fs_sparse_matrix_free(&a);
+    fs_sparse_builder_free(&bld);
+}
+
 int main(void)
 {
     RUN(test_builder_sums_duplicates);
@@ -1131,5 +1155,6 @@ int main(void)
     RUN(test_pcg_small_cases);
     RUN(test_cg_dot_orders);
     RUN(test_cholesky_independent_of_blas_threads);
+    RUN(test_cholesky_openmp_regions_serial);
     return check_finish();
 }

@@ -419,23 +419,36 @@ void fs_cholesky_free(fs_cholesky *c)
  * factorization, whatever -j and the environment say. It costs next to nothing on the presets (mud:
  * 8.6 to 11 s with one BLAS thread or two on two cores: the supernodes are small); the thread budget
  * goes to the work that splits without changing a bit (sampling, Delaunay blocks, the rasteriser).
- * Another BLAS is left as it is configured. */
+ * Another BLAS is left as it is configured.
+ *
+ * CHOLMOD itself (Debian's, built with OpenMP) opens parallel regions of a fixed 4 threads inside the
+ * supernodal factorization to clear and copy each supernode's block: thousands of forks and joins
+ * per factorization, each waking threads through futexes, which on two cores cost more than the
+ * copies (the shell's whole-sphere factorization at 20k triangles, 10 GFlop: 1.43 s, and 0.77 s with
+ * those regions on one thread, with another process running). OpenMP's max-active-levels set to 0
+ * (omp_set_max_active_levels, looked up the same way in the libgomp CHOLMOD loads) runs every
+ * parallel region on the calling thread; fissure itself uses no OpenMP. */
 static void apply_blas_threads(void)
 {
     static bool looked_up;
     static void (*set_threads)(int);
+    static void (*set_levels)(int);
     if (!looked_up) {
         looked_up = true;
         void *self = dlopen(NULL, RTLD_LAZY);
         if (self) {
             *(void **)(&set_threads) = dlsym(self, "openblas_set_num_threads");
+            *(void **)(&set_levels) = dlsym(self, "omp_set_max_active_levels");
             dlclose(self);
         }
-        fs_debug("cholmod: BLAS %s", set_threads ? "on one thread (openblas_set_num_threads)"
-                                                 : "left as configured (not OpenBLAS)");
+        fs_debug("cholmod: BLAS %s; OpenMP regions %s", set_threads ? "on one thread (openblas_set_num_threads)"
+                                                                    : "left as configured (not OpenBLAS)",
+                 set_levels ? "on the calling thread (omp_set_max_active_levels)" : "absent");
     }
     if (set_threads)
         set_threads(1);
+    if (set_levels)
+        set_levels(0);
 }
 
 typedef enum { ANALYZE_BEST, ANALYZE_AMD, ANALYZE_SMALL } analyze_mode;
