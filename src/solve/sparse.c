@@ -451,26 +451,36 @@ static void apply_blas_threads(void)
         set_levels(0);
 }
 
-typedef enum { ANALYZE_BEST, ANALYZE_AMD, ANALYZE_SMALL } analyze_mode;
+typedef enum { ANALYZE_BEST, ANALYZE_AMD, ANALYZE_SMALL, ANALYZE_GIVEN } analyze_mode;
 
-static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode);
+static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode, const int32_t *perm);
 
 fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a)
 {
-    return analyze(a, ANALYZE_BEST);
+    return analyze(a, ANALYZE_BEST, NULL);
 }
 
 fs_cholesky *fs_cholesky_analyze_amd(const fs_sparse_matrix *a)
 {
-    return analyze(a, ANALYZE_AMD);
+    return analyze(a, ANALYZE_AMD, NULL);
 }
 
 fs_cholesky *fs_cholesky_analyze_small(const fs_sparse_matrix *a)
 {
-    return analyze(a, ANALYZE_SMALL);
+    return analyze(a, ANALYZE_SMALL, NULL);
 }
 
-static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode)
+fs_cholesky *fs_cholesky_analyze_given(const fs_sparse_matrix *a, const int32_t *perm)
+{
+    return analyze(a, ANALYZE_GIVEN, perm);
+}
+
+const int32_t *fs_cholesky_permutation(const fs_cholesky *c)
+{
+    return c->symbolic->Perm;
+}
+
+static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode, const int32_t *perm)
 {
     apply_blas_threads();
     fs_cholesky *c = fs_calloc(1, sizeof *c);
@@ -493,9 +503,10 @@ static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode)
      * (bench_wedge), for a few tens of ms more per analysis. */
     c->common.nmethods = 3;
     if (mode != ANALYZE_BEST) {
-        /* fs_cholesky_analyze_amd: AMD alone; _small: and a simplicial factor (no BLAS calls) */
+        /* fs_cholesky_analyze_amd: AMD alone; _small: and a simplicial factor (no BLAS calls);
+         * _given: the caller's order (CHOLMOD still postorders its elimination tree) */
         c->common.nmethods = 1;
-        c->common.method[0].ordering = CHOLMOD_AMD;
+        c->common.method[0].ordering = mode == ANALYZE_GIVEN ? CHOLMOD_GIVEN : CHOLMOD_AMD;
         if (mode == ANALYZE_SMALL)
             c->common.supernodal = CHOLMOD_SIMPLICIAL;
     }
@@ -503,7 +514,7 @@ static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode)
     c->nnz = fs_sparse_matrix_nnz(a);
 
     cholmod_sparse view = wrap_matrix(a);
-    c->factor = cholmod_analyze(&view, &c->common);
+    c->factor = cholmod_analyze_p(&view, (int *)perm, NULL, 0, &c->common);
     if (!c->factor || c->common.status < CHOLMOD_OK) {
         report_failure(c, "analyze");
         fs_cholesky_free(c);
@@ -517,10 +528,10 @@ static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode)
     }
     c->factor_nonzeros = c->common.lnz;
     c->flops = c->common.fl;
-    const int *perm = c->factor->Perm;
+    const int *order = c->factor->Perm;
     c->inverse_perm = fs_malloc(((size_t)a->n + 1) * sizeof *c->inverse_perm);
     for (int32_t k = 0; k < a->n; k++)
-        c->inverse_perm[perm[k]] = k;
+        c->inverse_perm[order[k]] = k;
     return c;
 }
 

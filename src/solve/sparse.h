@@ -128,6 +128,16 @@ fs_cholesky *fs_cholesky_analyze_small(const fs_sparse_matrix *a);
  * factorizations (the shell model's, re-analysed after every cascade of cuts). */
 fs_cholesky *fs_cholesky_analyze_amd(const fs_sparse_matrix *a);
 
+/* fs_cholesky_analyze in the order perm (perm[k] = the unknown eliminated k-th, a permutation of
+ * 0..n-1; CHOLMOD keeps it up to a postorder of its elimination tree): the symbolic work alone, no
+ * ordering, for a pattern close to one already ordered (a mesh after a few cuts, its new unknowns
+ * placed beside those they came from). */
+fs_cholesky *fs_cholesky_analyze_given(const fs_sparse_matrix *a, const int32_t *perm);
+
+/* The order an analysis eliminates in: element k is the unknown eliminated k-th (n elements, owned
+ * by c). */
+const int32_t *fs_cholesky_permutation(const fs_cholesky *c);
+
 /* Numerically factorizes a with its current values. a must have the pattern given to
  * fs_cholesky_analyze (same n and entry count are checked with FS_ASSERT; the pattern itself is the
  * caller's contract). Call again after rewriting a->values to refactorize cheaply: the ordering and the

@@ -53,6 +53,7 @@ typedef struct {
     int64_t shifted;            /* factorizations retried with a diagonal shift (Hessian not positive) */
     int64_t solves;             /* equilibria */
     int64_t analyses;           /* symbolic analyses (new sparsity pattern after a cut) */
+    int64_t orderings;          /* of which the whole shell's ordered afresh (METIS) */
     int64_t plastic_updates;    /* triangles whose plastic strain changed, summed over steps */
     int64_t steps;              /* accepted time steps */
     int64_t search_evaluations; /* equilibria of the event search */
@@ -166,6 +167,9 @@ struct fs_shell {
     fs_shell_local local;          /* scratch of the local relaxations */
     fs_sparse_builder pattern;     /* scratch of every Hessian pattern built (the whole shell's after
                                       each cut, each local region's): its arrays are reused */
+    int32_t *order_rank;           /* per node: its place in the whole shell's elimination order */
+    int32_t order_nodes;           /* nodes that have a place (the rest came after) */
+    double order_flops;            /* flops of a factorization in the order made afresh last */
 
     int64_t fractures;
     fs_shell_counters counters;

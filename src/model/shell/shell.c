@@ -353,9 +353,9 @@ void fs_shell_report(const fs_shell *s)
              (int)s->n_nodes, (int)s->n_tris, (long long)s->fractures, (long long)c->budges, (long long)c->steps,
              (long long)c->search_evaluations);
     fs_debug("shell: %lld equilibria, %lld Newton steps, %lld factorizations (%lld shifted, %lld line-search halvings), "
-             "%lld analyses",
+             "%lld analyses (%lld orderings)",
              (long long)c->solves, (long long)c->back_solves, (long long)c->newton_iterations, (long long)c->shifted,
-             (long long)c->line_search_cuts, (long long)c->analyses);
+             (long long)c->line_search_cuts, (long long)c->analyses, (long long)c->orderings);
     fs_debug("shell: assembly %.2f s, factorization %.2f s, solves %.2f s in all, fracture %.2f s; %lld plastic updates",
              c->assemble_seconds, c->factor_seconds, c->solve_seconds, c->fracture_seconds,
              (long long)c->plastic_updates);
@@ -402,6 +402,7 @@ void fs_shell_destroy(fs_shell *s)
     free(s->local.in);
     free(s->local.tris);
     fs_sparse_builder_free(&s->pattern);
+    free(s->order_rank);
     fs_shell_system_free(&s->sys);
     free(s);
 }
