@@ -451,18 +451,13 @@ static void apply_blas_threads(void)
         set_levels(0);
 }
 
-typedef enum { ANALYZE_BEST, ANALYZE_AMD, ANALYZE_SMALL, ANALYZE_GIVEN } analyze_mode;
+typedef enum { ANALYZE_BEST, ANALYZE_SMALL, ANALYZE_GIVEN } analyze_mode;
 
 static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode, const int32_t *perm);
 
 fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a)
 {
     return analyze(a, ANALYZE_BEST, NULL);
-}
-
-fs_cholesky *fs_cholesky_analyze_amd(const fs_sparse_matrix *a)
-{
-    return analyze(a, ANALYZE_AMD, NULL);
 }
 
 fs_cholesky *fs_cholesky_analyze_small(const fs_sparse_matrix *a)
@@ -503,8 +498,8 @@ static fs_cholesky *analyze(const fs_sparse_matrix *a, analyze_mode mode, const 
      * (bench_wedge), for a few tens of ms more per analysis. */
     c->common.nmethods = 3;
     if (mode != ANALYZE_BEST) {
-        /* fs_cholesky_analyze_amd: AMD alone; _small: and a simplicial factor (no BLAS calls);
-         * _given: the caller's order (CHOLMOD still postorders its elimination tree) */
+        /* fs_cholesky_analyze_small: AMD alone and a simplicial factor (no BLAS calls); _given: the
+         * caller's order (CHOLMOD still postorders its elimination tree) */
         c->common.nmethods = 1;
         c->common.method[0].ordering = mode == ANALYZE_GIVEN ? CHOLMOD_GIVEN : CHOLMOD_AMD;
         if (mode == ANALYZE_SMALL)

@@ -123,11 +123,6 @@ fs_cholesky *fs_cholesky_analyze(const fs_sparse_matrix *a);
  * work to the BLAS's threads and back. Results as fs_cholesky_analyze's up to rounding. */
 fs_cholesky *fs_cholesky_analyze_small(const fs_sparse_matrix *a);
 
-/* fs_cholesky_analyze with AMD alone (no METIS), the factor supernodal or simplicial as CHOLMOD
- * chooses: for a large system whose pattern changes often, so that each analysis serves only a few
- * factorizations (the shell model's, re-analysed after every cascade of cuts). */
-fs_cholesky *fs_cholesky_analyze_amd(const fs_sparse_matrix *a);
-
 /* fs_cholesky_analyze in the order perm (perm[k] = the unknown eliminated k-th, a permutation of
  * 0..n-1; CHOLMOD keeps it up to a postorder of its elimination tree): the symbolic work alone, no
  * ordering, for a pattern close to one already ordered (a mesh after a few cuts, its new unknowns
