@@ -146,9 +146,11 @@ int fs_sparse_builder_compress(fs_sparse_builder *b, fs_sparse_matrix *out, int3
                    3 * ((size_t)n + 1) * sizeof(int32_t);
     size_t need = (bytes + sizeof(size_t) - 1) / sizeof(size_t);
     if (need > b->scratch_size) {
+        /* with room to grow: a mesh being cut asks for a little more each time, and a block this
+         * large comes fresh from the kernel, page by page */
         free(b->scratch);
-        b->scratch = fs_malloc(need * sizeof *b->scratch);
-        b->scratch_size = need;
+        b->scratch_size = need + need / 2;
+        b->scratch = fs_malloc(b->scratch_size * sizeof *b->scratch);
     }
     size_t *start = b->scratch, *cursor = start + (size_t)n + 1;
     column_entry *bucket = (column_entry *)(cursor + (size_t)n + 1);
