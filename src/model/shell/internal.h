@@ -165,8 +165,6 @@ struct fs_shell {
     double *work;                  /* scratch: 2 n_free + 6 n_nodes (reallocated to fit) */
     size_t work_size;
     fs_shell_local local;          /* scratch of the local relaxations */
-    fs_sparse_builder pattern;     /* scratch of every Hessian pattern built (the whole shell's after
-                                      each cut, each local region's): its arrays are reused */
     int32_t *order_rank;           /* per node: its place in the whole shell's elimination order */
     int32_t order_nodes;           /* nodes that have a place (the rest came after) */
     double order_flops;            /* flops of a factorization in the order made afresh last */

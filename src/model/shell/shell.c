@@ -401,7 +401,6 @@ void fs_shell_destroy(fs_shell *s)
     free(s->local.dof);
     free(s->local.in);
     free(s->local.tris);
-    fs_sparse_builder_free(&s->pattern);
     free(s->order_rank);
     fs_shell_system_free(&s->sys);
     free(s);
