@@ -454,12 +454,10 @@ static int32_t pattern_slot(const fs_sparse_matrix *K, const int32_t *first, con
     return K->col_ptr[c] + nb[lo].before + (r - fr);
 }
 
-/* The first DOF of each stencil node, -1 for a node without one. */
-static int stencil_firsts(const fs_shell *s, const fs_shell_system *sys, const int32_t *first, int32_t t,
-                          int32_t nodes[6], int32_t fr[6])
+/* The first DOF of each of the k stencil nodes, -1 for a node without one. */
+static void stencil_firsts(const fs_shell_system *sys, const int32_t *first, const int32_t *nodes, int k,
+                           int32_t fr[6])
 {
-    int loc[3], opp[3];
-    int k = stencil(s, t, nodes, loc, opp);
     for (int q = 0; q < k; q++) {
         fr[q] = -1;
         for (int c = 0; c < 3 && fr[q] < 0; c++) {
@@ -468,6 +466,14 @@ static int stencil_firsts(const fs_shell *s, const fs_shell_system *sys, const i
                 fr[q] = first[d];
         }
     }
+}
+
+/* The nodes of a stored stencil (6 slots, -1 past the last). */
+static int stencil_size(const int32_t *nodes)
+{
+    int k = 0;
+    while (k < 6 && nodes[k] >= 0)
+        k++;
     return k;
 }
 
@@ -513,11 +519,17 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
             }
         }
     }
-    /* the stencil pairs of each column node (with repeats), then sorted and deduplicated */
+    /* the stencils once (6 nodes a triangle, -1 past its k), and the stencil pairs of each column
+     * node (with repeats), then sorted and deduplicated */
+    int32_t *st = fs_malloc(6 * ((size_t)nt + 1) * sizeof *st);
     size_t n_slots = 6 * (size_t)nn;
     for (int32_t q = 0; q < nt; q++) {
-        int32_t nodes[6], fr[6];
-        int k = stencil_firsts(s, sys, first, scope_tri(sys, q), nodes, fr);
+        int32_t *nodes = st + 6 * (size_t)q, fr[6];
+        int loc[3], opp[3];
+        int k = stencil(s, scope_tri(sys, q), nodes, loc, opp);
+        for (int a = k; a < 6; a++)
+            nodes[a] = -1;
+        stencil_firsts(sys, first, nodes, k, fr);
         n_slots += (size_t)(3 * k) * (size_t)(3 * k + 1) / 2;
         for (int a = 0; a < k; a++)
             for (int b = 0; b < k; b++)
@@ -530,8 +542,10 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
     int32_t *cursor = fs_malloc(((size_t)nf + 1) * sizeof *cursor);
     memcpy(cursor, nb_start, (size_t)nf * sizeof *cursor);
     for (int32_t q = 0; q < nt; q++) {
-        int32_t nodes[6], fr[6];
-        int k = stencil_firsts(s, sys, first, scope_tri(sys, q), nodes, fr);
+        const int32_t *nodes = st + 6 * (size_t)q;
+        int32_t fr[6];
+        int k = stencil_size(nodes);
+        stencil_firsts(sys, first, nodes, k, fr);
         for (int a = 0; a < k; a++)
             for (int b = 0; b < k; b++)
                 if (fr[a] >= 0 && fr[a] < fr[b])
@@ -568,7 +582,7 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
         if (nnz > INT32_MAX) {
             fs_error(FS_ERR_INTERNAL, "shell: the Hessian's %lld stored entries exceed the 32-bit index range",
                      (long long)nnz);
-            free(first), free(own), free(count), free(nb_start), free(nb), free(cursor);
+            free(first), free(own), free(count), free(nb_start), free(nb), free(cursor), free(st);
             return -1;
         }
     }
@@ -587,15 +601,16 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
     sys->slots = fs_malloc((n_slots + 1) * sizeof *sys->slots);
     int32_t *out = sys->slots;
     for (int32_t q = 0; q < nt; q++) {
-        int32_t nodes[6], idx[18], fr[6];
-        int k = stencil_firsts(s, sys, first, scope_tri(sys, q), nodes, fr);
+        const int32_t *nodes = st + 6 * (size_t)q;
+        int32_t idx[18];
+        int k = stencil_size(nodes);
         block_dofs(sys, nodes, k, idx);
         out = block_slots(K, first, own, nb_start, nb, idx, 3 * k, out);
     }
     for (int32_t q = 0; q < nn; q++)
         out = block_slots(K, first, own, nb_start, nb, sys->dof + 3 * (size_t)scope_node(sys, q), 3, out);
     sys->n_slots = (size_t)(out - sys->slots);
-    free(first), free(own), free(count), free(nb_start), free(nb), free(cursor);
+    free(first), free(own), free(count), free(nb_start), free(nb), free(cursor), free(st);
     sys->pattern_valid = true;
     return 0;
 }
