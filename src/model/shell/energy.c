@@ -401,26 +401,6 @@ void fs_shell_system_free(fs_shell_system *sys)
     memset(sys, 0, sizeof *sys);
 }
 
-static int32_t scope_tris(const fs_shell *s, const fs_shell_system *sys)
-{
-    return sys->tris ? sys->n_tris : s->mesh->n_tris;
-}
-
-static int32_t scope_tri(const fs_shell_system *sys, int32_t q)
-{
-    return sys->tris ? sys->tris[q] : q;
-}
-
-static int32_t scope_nodes(const fs_shell *s, const fs_shell_system *sys)
-{
-    return sys->nodes ? sys->n_nodes : s->n_nodes;
-}
-
-static int32_t scope_node(const fs_shell_system *sys, int32_t q)
-{
-    return sys->nodes ? sys->nodes[q] : q;
-}
-
 /* design: the Hessian's pattern is built a node at a time. DOFs are numbered a node at a time (its
  * free components consecutive), so the column of a DOF holds all the DOFs of every node that shares
  * a stencil with its node and comes before it, then its own node's up to the diagonal. Each node's
@@ -435,13 +415,13 @@ typedef struct {
     int32_t before;
 } neighbour;
 
-/* The slot of entry (r, c), r <= c: in column c, after the neighbours of c's node before r's node. */
-static int32_t pattern_slot(const fs_sparse_matrix *K, const int32_t *first, const int32_t *own,
-                            const int32_t *nb_start, const neighbour *nb, int32_t r, int32_t c)
+/* Where the rows of node fr start in the columns of node fc (fr <= fc, their first DOFs): entry
+ * (r, c) of the pair is at col_ptr[c] + this + (r - fr). A column holds its node's earlier
+ * neighbours, then its own node's DOFs up to the diagonal. */
+static int32_t pair_base(const int32_t *own, const int32_t *nb_start, const neighbour *nb, int32_t fr, int32_t fc)
 {
-    int32_t fc = first[c], fr = first[r];
     if (fr == fc)
-        return K->col_ptr[c] + own[fc] + (r - fc);
+        return own[fc];
     int32_t lo = nb_start[fc], hi = nb_start[fc + 1] - 1;
     while (lo < hi) {
         int32_t mid = (lo + hi) / 2;
@@ -451,7 +431,7 @@ static int32_t pattern_slot(const fs_sparse_matrix *K, const int32_t *first, con
             hi = mid;
     }
     FS_ASSERT(nb[lo].first == fr);
-    return K->col_ptr[c] + nb[lo].before + (r - fr);
+    return nb[lo].before;
 }
 
 /* The first DOF of each of the k stencil nodes, -1 for a node without one. */
@@ -477,17 +457,31 @@ static int stencil_size(const int32_t *nodes)
     return k;
 }
 
-/* Appends the slots of a block over idx (k DOFs, -1 skipped) in fs_sparse_matrix_add_block's order. */
+/* Appends the slots of a block over idx (k DOFs, 3 a node, -1 skipped) in fs_sparse_matrix_add_block's
+ * order; the place of each pair of its nodes is found once. */
 static int32_t *block_slots(const fs_sparse_matrix *K, const int32_t *first, const int32_t *own,
                             const int32_t *nb_start, const neighbour *nb, const int32_t *idx, int k, int32_t *out)
 {
+    int32_t fn[6], base[6][6];
+    int kn = k / 3;
+    for (int i = 0; i < kn; i++) {
+        fn[i] = -1;
+        for (int c = 0; c < 3 && fn[i] < 0; c++)
+            if (idx[3 * i + c] >= 0)
+                fn[i] = first[idx[3 * i + c]];
+    }
+    for (int i = 0; i < kn; i++)
+        for (int j = i; j < kn; j++)
+            if (fn[i] >= 0 && fn[j] >= 0)
+                base[i][j] = base[j][i] = fn[i] < fn[j] ? pair_base(own, nb_start, nb, fn[i], fn[j])
+                                                        : pair_base(own, nb_start, nb, fn[j], fn[i]);
     for (int a = 0; a < k; a++) {
         if (idx[a] < 0)
             continue;
         for (int c = a; c < k; c++)
             if (idx[c] >= 0) {
                 int32_t lo = idx[a] < idx[c] ? idx[a] : idx[c], hi = idx[a] < idx[c] ? idx[c] : idx[a];
-                *out++ = pattern_slot(K, first, own, nb_start, nb, lo, hi);
+                *out++ = K->col_ptr[hi] + base[a / 3][c / 3] + (lo - first[lo]);
             }
     }
     return out;
@@ -502,14 +496,14 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
     fs_cholesky_free(sys->chol);
     sys->chol = NULL;
     sys->factored = false;
-    int32_t nt = scope_tris(s, sys), nn = scope_nodes(s, sys), nf = sys->n_free;
+    int32_t nt = fs_shell_scope_tris(s->mesh->n_tris, sys), nn = fs_shell_scope_nodes(s->n_nodes, sys), nf = sys->n_free;
     /* each DOF's node, named by its first DOF; own[f]: the DOFs of node f's earlier neighbours */
     int32_t *first = fs_malloc(((size_t)nf + 1) * sizeof *first);
     int32_t *own = fs_calloc((size_t)nf + 1, sizeof *own);
     int32_t *count = fs_calloc((size_t)nf + 1, sizeof *count);
     int32_t *nb_start = fs_calloc((size_t)nf + 2, sizeof *nb_start);
     for (int32_t q = 0; q < nn; q++) {
-        int32_t i = scope_node(sys, q), f = -1;
+        int32_t i = fs_shell_scope_node(sys, q), f = -1;
         for (int c = 0; c < 3; c++) {
             int32_t d = sys->dof[3 * (size_t)i + c];
             if (d >= 0) {
@@ -526,7 +520,7 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
     for (int32_t q = 0; q < nt; q++) {
         int32_t *nodes = st + 6 * (size_t)q, fr[6];
         int loc[3], opp[3];
-        int k = stencil(s, scope_tri(sys, q), nodes, loc, opp);
+        int k = stencil(s, fs_shell_scope_tri(sys, q), nodes, loc, opp);
         for (int a = k; a < 6; a++)
             nodes[a] = -1;
         stencil_firsts(sys, first, nodes, k, fr);
@@ -608,7 +602,7 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
         out = block_slots(K, first, own, nb_start, nb, idx, 3 * k, out);
     }
     for (int32_t q = 0; q < nn; q++)
-        out = block_slots(K, first, own, nb_start, nb, sys->dof + 3 * (size_t)scope_node(sys, q), 3, out);
+        out = block_slots(K, first, own, nb_start, nb, sys->dof + 3 * (size_t)fs_shell_scope_node(sys, q), 3, out);
     sys->n_slots = (size_t)(out - sys->slots);
     free(first), free(own), free(count), free(nb_start), free(nb), free(cursor), free(st);
     sys->pattern_valid = true;
@@ -630,6 +624,39 @@ static void scope_phi(fs_shell *s, const fs_shell_system *sys, const double *p, 
         }
 }
 
+/* Zeroes what an evaluation over sys's scope accumulates: the gradient (g, may be NULL) at the
+ * corners of its triangles and of the hinges they own, and dE/dphi (gphi, may be NULL) at those
+ * hinges; everywhere for the whole shell. A local relaxation's scope is a few hundred of the
+ * shell's nodes, so clearing only it keeps the cost of its evaluations to its size. */
+static void clear_scope(const fs_shell *s, const fs_shell_system *sys, double *g, double *gphi)
+{
+    const fs_mesh *m = s->mesh;
+    if (!sys->tris) {
+        if (g)
+            memset(g, 0, 3 * (size_t)s->n_nodes * sizeof *g);
+        if (gphi)
+            memset(gphi, 0, 3 * (size_t)m->n_tris * sizeof *gphi);
+        return;
+    }
+    for (int32_t q = 0; q < sys->n_tris; q++) {
+        int32_t t = sys->tris[q];
+        for (int i = 0; i < 3; i++) {
+            int32_t o = fs_shell_owner(s, 3 * t + i);
+            if (g) {
+                memset(g + 3 * (size_t)m->tri[3 * (size_t)t + i], 0, 3 * sizeof *g);
+                if (o >= 0)
+                    for (int v = 0; v < 4; v++)
+                        memset(g + 3 * (size_t)s->hinge[4 * (size_t)o + v], 0, 3 * sizeof *g);
+            }
+            if (gphi && o >= 0)
+                gphi[o] = 0.0;
+        }
+    }
+    if (g)
+        for (int32_t q = 0; q < sys->n_nodes; q++)
+            memset(g + 3 * (size_t)sys->nodes[q], 0, 3 * sizeof *g);
+}
+
 double fs_shell_energy(fs_shell *s, const double *p, double *grad, bool hessian)
 {
     return fs_shell_energy_in(s, &s->sys, p, grad, hessian);
@@ -643,19 +670,17 @@ double fs_shell_energy_in(fs_shell *s, fs_shell_system *sys, const double *p, do
         return NAN;
     bool derivs = grad || hessian;
     scope_phi(s, sys, p, derivs);
-    int32_t nt = scope_tris(s, sys), nn = scope_nodes(s, sys);
+    int32_t nt = fs_shell_scope_tris(s->mesh->n_tris, sys), nn = fs_shell_scope_nodes(s->n_nodes, sys);
     double nu = s->cfg.material.poisson;
     double energy = 0.0;
     double *g = grad;
-    if (g)
-        memset(g, 0, 3 * (size_t)s->n_nodes * sizeof *g);
     /* dE/dphi per edge, summed over its two triangles, for the hinges' second derivatives */
-    double *gphi = NULL;
-    if (hessian)
-        gphi = fs_calloc(3 * (size_t)m->n_tris + 1, sizeof *gphi);
+    double *gphi = hessian ? s->gphi : NULL;
+    if (g || gphi)
+        clear_scope(s, sys, g, gphi);
     /* pass 1: energies, gradients and dE/dphi */
     for (int32_t q = 0; q < nt; q++) {
-        int32_t t = scope_tri(sys, q);
+        int32_t t = fs_shell_scope_tri(sys, q);
         double em[3], ec[3];
         fs_shell_elastic_strains(s, p, t, em, ec);
         double h = fs_shell_tri_thickness(s, t), A = s->area0[t], Y = s->young[t];
@@ -702,7 +727,7 @@ double fs_shell_energy_in(fs_shell *s, fs_shell_system *sys, const double *p, do
     }
     /* the bond and the loads */
     for (int32_t q = 0; q < nn && isfinite(energy); q++) {
-        int32_t i = scope_node(sys, q);
+        int32_t i = fs_shell_scope_node(sys, q);
         double K[9], d[3], f[3];
         bond_matrix(s, i, K);
         fs_sub3(d, p + 3 * (size_t)i, s->anchor + 3 * (size_t)i);
@@ -715,7 +740,6 @@ double fs_shell_energy_in(fs_shell *s, fs_shell_system *sys, const double *p, do
                 g[3 * (size_t)i + a] += f[a] - fe[a];
     }
     if (!isfinite(energy) || !hessian) {
-        free(gphi);
         s->counters.assemble_seconds += fs_seconds() - t_start;
         return isfinite(energy) ? energy : NAN;
     }
@@ -725,7 +749,7 @@ double fs_shell_energy_in(fs_shell *s, fs_shell_system *sys, const double *p, do
     const int32_t *slot = sys->slots;
     double ke[18 * 18];
     for (int32_t q = 0; q < nt; q++) {
-        int32_t t = scope_tri(sys, q);
+        int32_t t = fs_shell_scope_tri(sys, q);
         int32_t nodes[6], idx[18];
         int loc[3], opp[3];
         int k = stencil(s, t, nodes, loc, opp), n = 3 * k;
@@ -808,13 +832,12 @@ double fs_shell_energy_in(fs_shell *s, fs_shell_system *sys, const double *p, do
         slot += fs_sparse_matrix_add_block(&sys->K, n, idx, ke, slot);
     }
     for (int32_t q = 0; q < nn; q++) {
-        int32_t i = scope_node(sys, q);
+        int32_t i = fs_shell_scope_node(sys, q);
         double K[9];
         bond_matrix(s, i, K);
         slot += fs_sparse_matrix_add_block(&sys->K, 3, sys->dof + 3 * (size_t)i, K, slot);
     }
     FS_ASSERT((size_t)(slot - sys->slots) == sys->n_slots);
-    free(gphi);
     s->counters.assemble_seconds += fs_seconds() - t_start;
     return energy;
 }

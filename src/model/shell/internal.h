@@ -84,6 +84,24 @@ typedef struct {
     bool factored;                 /* chol holds the factor of a recent Hessian of the current pattern */
 } fs_shell_system;
 
+/* The triangles and nodes of a system's scope, the q-th of each. */
+static inline int32_t fs_shell_scope_tris(int32_t n_tris, const fs_shell_system *sys)
+{
+    return sys->tris ? sys->n_tris : n_tris;
+}
+static inline int32_t fs_shell_scope_tri(const fs_shell_system *sys, int32_t q)
+{
+    return sys->tris ? sys->tris[q] : q;
+}
+static inline int32_t fs_shell_scope_nodes(int32_t n_nodes, const fs_shell_system *sys)
+{
+    return sys->nodes ? sys->n_nodes : n_nodes;
+}
+static inline int32_t fs_shell_scope_node(const fs_shell_system *sys, int32_t q)
+{
+    return sys->nodes ? sys->nodes[q] : q;
+}
+
 /* Releases a system's arrays and factor and zeroes it. */
 void fs_shell_system_free(fs_shell_system *sys);
 
@@ -159,6 +177,7 @@ struct fs_shell {
     double *phi;                   /* per half-edge, at owners: phi at the positions of the last
                                       evaluation */
     double *dphi;                  /* 12 per half-edge, at owners: its gradient there */
+    double *gphi;                  /* 3 per triangle, at owners: dE/dphi (scratch of the Hessian) */
 
     fs_shell_system sys;           /* the whole shell's system (no scope) */
     double *grad;                  /* 3 per node: gradient of the energy at x */

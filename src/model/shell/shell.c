@@ -134,6 +134,7 @@ static void reserve_tris(fs_shell *s, int32_t n)
     GROW(phi0, 3);
     GROW(phi, 3);
     GROW(dphi, 36);
+    GROW(gphi, 3);
     s->cap_tris = cap;
 }
 
@@ -397,6 +398,7 @@ void fs_shell_destroy(fs_shell *s)
     free(s->phi0);
     free(s->phi);
     free(s->dphi);
+    free(s->gphi);
     free(s->work);
     free(s->local.dof);
     free(s->local.in);

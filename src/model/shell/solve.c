@@ -208,8 +208,8 @@ static int factorize(fs_shell *s, fs_shell_system *sys)
 static double residual(const fs_shell *s, const fs_shell_system *sys, const double *g, double *r)
 {
     double rmax = 0.0;
-    for (int32_t i = 0; i < s->n_nodes; i++)
-        for (int k = 0; k < 3; k++) {
+    for (int32_t q = 0, n = fs_shell_scope_nodes(s->n_nodes, sys); q < n; q++)
+        for (int k = 0, i = fs_shell_scope_node(sys, q); k < 3; k++) {
             int32_t d = sys->dof[3 * (size_t)i + k];
             if (d >= 0) {
                 r[d] = -g[3 * (size_t)i + k];
@@ -246,6 +246,9 @@ int fs_shell_solve(fs_shell *s, fs_shell_system *sys)
     s->counters.solves++;
     double t0 = fs_seconds();
     double e = fs_shell_energy_in(s, sys, s->x, g, false);
+    /* the trial positions: x, but for the scope's nodes (the only ones that move) */
+    int32_t n_scope = fs_shell_scope_nodes(nn, sys);
+    memcpy(trial, s->x, 3 * (size_t)nn * sizeof *trial);
     bool refresh = !sys->factored, fresh = false;
     for (int iter = 0; iter < MAX_NEWTON && isfinite(e); iter++) {
         double rmax = residual(s, sys, g, r);
@@ -278,12 +281,11 @@ int fs_shell_solve(fs_shell *s, fs_shell_system *sys)
         double alpha = 1.0, et = NAN;
         bool accepted = false;
         for (int cut = 0; cut < MAX_CUTS; cut++) {
-            memcpy(trial, s->x, 3 * (size_t)nn * sizeof *trial);
-            for (int32_t i = 0; i < nn; i++)
-                for (int k = 0; k < 3; k++) {
-                    int32_t d = sys->dof[3 * (size_t)i + k];
-                    if (d >= 0)
-                        trial[3 * (size_t)i + k] += alpha * p[d];
+            for (int32_t q = 0; q < n_scope; q++)
+                for (int k = 0, i = fs_shell_scope_node(sys, q); k < 3; k++) {
+                    size_t c = 3 * (size_t)i + k;
+                    int32_t d = sys->dof[c];
+                    trial[c] = d >= 0 ? s->x[c] + alpha * p[d] : s->x[c];
                 }
             et = fs_shell_energy_in(s, sys, trial, gt, false);
             /* Armijo, with room for rounding once the decrease is below it */
@@ -302,8 +304,11 @@ int fs_shell_solve(fs_shell *s, fs_shell_system *sys)
             refresh = true;
             continue;
         }
-        memcpy(s->x, trial, 3 * (size_t)nn * sizeof *trial);
-        memcpy(g, gt, 3 * (size_t)nn * sizeof *g);
+        for (int32_t q = 0; q < n_scope; q++) {
+            size_t i = (size_t)fs_shell_scope_node(sys, q);
+            memcpy(s->x + 3 * i, trial + 3 * i, 3 * sizeof *trial);
+            memcpy(g + 3 * i, gt + 3 * i, 3 * sizeof *g);
+        }
         e = et;
         if (alpha * pmax <= x_tol) {
             s->counters.solve_seconds += fs_seconds() - t0;
