@@ -701,14 +701,12 @@ int32_t fs_shell_fracture_batch(fs_shell *s, int32_t **seeds, int32_t *n_seeds)
     int32_t n = s->n_tris;
     double *ratio = fs_malloc(((size_t)n + 1) * sizeof *ratio);
     double *mdir = fs_malloc(2 * ((size_t)n + 1) * sizeof *mdir);
-    fs_shell_update_phi(s, s->x, false);
+    fs_shell_face_ratios(s, ratio, mdir);
     int32_t n_cand = 0;
     int32_t *cand = fs_malloc(((size_t)n + 1) * sizeof *cand);
-    for (int32_t t = 0; t < n; t++) {
-        ratio[t] = fs_shell_face_ratio(s, t, mdir + 2 * (size_t)t);
+    for (int32_t t = 0; t < n; t++)
         if (ratio[t] > 1.0)
             cand[n_cand++] = t;
-    }
     double *cr = fs_malloc(((size_t)n_cand + 1) * sizeof *cr);
     uint64_t *cid = fs_malloc(((size_t)n_cand + 1) * sizeof *cid);
     for (int32_t q = 0; q < n_cand; q++) {

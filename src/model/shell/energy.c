@@ -7,6 +7,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "base/threads.h"
 #include "base/vec.h"
 
 /* ---- geometry ---- */
@@ -241,11 +242,62 @@ static void hinge_phi_at(fs_shell *s, const double *p, int32_t h, bool with_grad
     s->phi[h] = fs_shell_hinge_phi(x, with_grad ? s->dphi + 12 * (size_t)h : NULL, NULL);
 }
 
+/* ---- whole-shell passes on several threads ---- */
+
+/* design: the whole shell is evaluated thousands of times a run (every Newton step of every
+ * equilibrium, every test of the fracture criterion), each time over every hinge and triangle. The
+ * per-hinge and per-triangle work (bending angles, strains, stresses, a triangle's own forces) runs
+ * on fs_threads() threads in PASS_PARTS fixed parts, each item writing only its own slots; whatever
+ * sums over items (energy, nodal forces) is then added up in item order on one thread: the same
+ * floating-point operations in the same order as one loop, so the results are the same for any
+ * thread count, and the same as before the passes were split. Scopes of fewer than PASS_MIN items
+ * (a local relaxation's) stay on the calling thread. */
+#define PASS_PARTS 32
+#define PASS_MIN 4096
+
+typedef struct {
+    fs_shell_range_fn fn;
+    void *ctx;
+    int32_t n;
+} pass_work;
+
+static void pass_part(void *ctx, int32_t part)
+{
+    const pass_work *w = ctx;
+    int32_t i0, i1;
+    fs_parallel_part(w->n, PASS_PARTS, part, &i0, &i1);
+    w->fn(w->ctx, i0, i1);
+}
+
+void fs_shell_parallel(int32_t n, fs_shell_range_fn fn, void *ctx)
+{
+    if (n < PASS_MIN) {
+        fn(ctx, 0, n);
+        return;
+    }
+    pass_work w = {fn, ctx, n};
+    fs_parallel_for(PASS_PARTS, 0, pass_part, &w);
+}
+
+typedef struct {
+    fs_shell *s;
+    const fs_shell_system *sys;
+    const double *p;
+    bool with_grad, derivs;
+} pass_ctx;
+
+static void phi_range(void *ctx, int32_t h0, int32_t h1)
+{
+    const pass_ctx *c = ctx;
+    for (int32_t h = h0; h < h1; h++)
+        if (fs_shell_owner(c->s, h) == h)
+            hinge_phi_at(c->s, c->p, h, c->with_grad);
+}
+
 void fs_shell_update_phi(fs_shell *s, const double *p, bool with_grad)
 {
-    for (int32_t h = 0; h < 3 * s->mesh->n_tris; h++)
-        if (fs_shell_owner(s, h) == h)
-            hinge_phi_at(s, p, h, with_grad);
+    pass_ctx c = {.s = s, .p = p, .with_grad = with_grad};
+    fs_shell_parallel(3 * s->mesh->n_tris, phi_range, &c);
 }
 
 /* ---- strains ---- */
@@ -624,6 +676,45 @@ static void scope_phi(fs_shell *s, const fs_shell_system *sys, const double *p, 
         }
 }
 
+/* The terms of each triangle of the scope (q in [q0, q1)) into s->terms: its energy, dE/dphi of its
+ * three edges (with derivs), and the membrane forces on its corners (with with_grad). */
+#define TERMS 13
+static void tri_terms(void *ctx, int32_t q0, int32_t q1)
+{
+    const pass_ctx *c = ctx;
+    const fs_shell *s = c->s;
+    double nu = s->cfg.material.poisson;
+    for (int32_t q = q0; q < q1; q++) {
+        int32_t t = fs_shell_scope_tri(c->sys, q);
+        double *term = s->terms + TERMS * (size_t)t, *dedphi = term + 1;
+        double em[3], ec[3];
+        fs_shell_elastic_strains(s, c->p, t, em, ec);
+        double h = fs_shell_tri_thickness(s, t), A = s->area0[t], Y = s->young[t];
+        double sm[3], sc[3];
+        double wm = density(em, nu, sm), wc = density(ec, nu, sc);
+        double km = A * h * Y, kb = A * h * h * h / 12.0 * Y;
+        term[0] = km * wm + kb * wc;
+        if (!c->derivs)
+            continue;
+        for (int i = 0; i < 3; i++) {
+            const double *T = s->bend_t + 9 * (size_t)t + 3 * i;
+            dedphi[i] = kb * s->bend_c[3 * (size_t)t + i] * (sc[0] * T[0] + sc[1] * T[1] + 2.0 * sc[2] * T[2]);
+        }
+        if (!c->with_grad)
+            continue;
+        /* membrane: grad_a = km F S g_a */
+        double f0[3], f1[3];
+        deformation_gradient(s, c->p, t, f0, f1);
+        const double *di = s->dm_inv + 4 * (size_t)t;
+        double ga[3][2] = {{-di[0] - di[2], -di[1] - di[3]}, {di[0], di[1]}, {di[2], di[3]}};
+        for (int a = 0; a < 3; a++) {
+            double w0 = sm[0] * ga[a][0] + sm[2] * ga[a][1], w1 = sm[2] * ga[a][0] + sm[1] * ga[a][1];
+            for (int k = 0; k < 3; k++)
+                term[4 + 3 * a + k] = km * (f0[k] * w0 + f1[k] * w1);
+        }
+    }
+}
+
 /* Zeroes what an evaluation over sys's scope accumulates: the gradient (g, may be NULL) at the
  * corners of its triangles and of the hinges they own, and dE/dphi (gphi, may be NULL) at those
  * hinges; everywhere for the whole shell. A local relaxation's scope is a few hundred of the
@@ -678,40 +769,28 @@ double fs_shell_energy_in(fs_shell *s, fs_shell_system *sys, const double *p, do
     double *gphi = hessian ? s->gphi : NULL;
     if (g || gphi)
         clear_scope(s, sys, g, gphi);
-    /* pass 1: energies, gradients and dE/dphi */
+    /* pass 1: each triangle's terms, then energies, gradients and dE/dphi summed in order */
+    pass_ctx pc = {.s = s, .sys = sys, .p = p, .with_grad = g != NULL, .derivs = derivs};
+    fs_shell_parallel(nt, tri_terms, &pc);
     for (int32_t q = 0; q < nt; q++) {
         int32_t t = fs_shell_scope_tri(sys, q);
-        double em[3], ec[3];
-        fs_shell_elastic_strains(s, p, t, em, ec);
-        double h = fs_shell_tri_thickness(s, t), A = s->area0[t], Y = s->young[t];
-        double sm[3], sc[3];
-        double wm = density(em, nu, sm), wc = density(ec, nu, sc);
-        double km = A * h * Y, kb = A * h * h * h / 12.0 * Y;
-        energy += km * wm + kb * wc;
+        const double *term = s->terms + TERMS * (size_t)t, *dedphi = term + 1;
+        energy += term[0];
         if (!isfinite(energy))
             break;
         if (!derivs)
             continue;
-        double dedphi[3];
         for (int i = 0; i < 3; i++) {
-            const double *T = s->bend_t + 9 * (size_t)t + 3 * i;
-            dedphi[i] = kb * s->bend_c[3 * (size_t)t + i] * (sc[0] * T[0] + sc[1] * T[1] + 2.0 * sc[2] * T[2]);
             int32_t o = fs_shell_owner(s, 3 * t + i);
             if (gphi && o >= 0)
                 gphi[o] += dedphi[i];
         }
         if (!g)
             continue;
-        /* membrane: grad_a = km F S g_a */
-        double f0[3], f1[3];
-        deformation_gradient(s, p, t, f0, f1);
-        const double *di = s->dm_inv + 4 * (size_t)t;
-        double ga[3][2] = {{-di[0] - di[2], -di[1] - di[3]}, {di[0], di[1]}, {di[2], di[3]}};
         for (int c = 0; c < 3; c++) {
-            double w0 = sm[0] * ga[c][0] + sm[2] * ga[c][1], w1 = sm[2] * ga[c][0] + sm[1] * ga[c][1];
             int32_t node = m->tri[3 * (size_t)t + c];
             for (int k = 0; k < 3; k++)
-                g[3 * (size_t)node + k] += km * (f0[k] * w0 + f1[k] * w1);
+                g[3 * (size_t)node + k] += term[4 + 3 * c + k];
         }
         /* bending: sum_i dE/dphi_i grad phi_i */
         for (int i = 0; i < 3; i++) {

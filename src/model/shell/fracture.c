@@ -86,17 +86,32 @@ double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2])
     return best / s->threshold[t];
 }
 
-double fs_shell_max_ratio(fs_shell *s, double *ratio)
+typedef struct {
+    const fs_shell *s;
+    double *ratio, *m;
+} ratios_ctx;
+
+static void ratios_range(void *ctx, int32_t t0, int32_t t1)
+{
+    const ratios_ctx *c = ctx;
+    for (int32_t t = t0; t < t1; t++)
+        c->ratio[t] = fs_shell_face_ratio(c->s, t, c->m ? c->m + 2 * (size_t)t : NULL);
+}
+
+void fs_shell_face_ratios(fs_shell *s, double *ratio, double *m)
 {
     fs_shell_update_phi(s, s->x, false);
-    double best = -INFINITY;
-    for (int32_t t = 0; t < s->n_tris; t++) {
-        double r = fs_shell_face_ratio(s, t, NULL);
-        if (ratio)
-            ratio[t] = r;
-        if (r > best)
-            best = r;
-    }
+    ratios_ctx c = {s, ratio, m};
+    fs_shell_parallel(s->n_tris, ratios_range, &c);
+}
+
+double fs_shell_max_ratio(fs_shell *s, double *ratio)
+{
+    double *r = ratio ? ratio : s->face_ratio, best = -INFINITY;
+    fs_shell_face_ratios(s, r, NULL);
+    for (int32_t t = 0; t < s->n_tris; t++)
+        if (r[t] > best)
+            best = r[t];
     return best;
 }
 

@@ -178,6 +178,8 @@ struct fs_shell {
                                       evaluation */
     double *dphi;                  /* 12 per half-edge, at owners: its gradient there */
     double *gphi;                  /* 3 per triangle, at owners: dE/dphi (scratch of the Hessian) */
+    double *terms;                 /* 13 per triangle: its energy terms (scratch of an evaluation) */
+    double *face_ratio;            /* per triangle: its fracture ratio (scratch of fs_shell_max_ratio) */
 
     fs_shell_system sys;           /* the whole shell's system (no scope) */
     double *grad;                  /* 3 per node: gradient of the energy at x */
@@ -225,6 +227,13 @@ void fs_shell_corner(const fs_shell *s, const double *p, int32_t t, int c, doubl
  * operator) of triangle t at the node positions p, in the triangle's rest frame, from the current
  * edge phi in s->phi (call fs_shell_update_phi first). */
 void fs_shell_strains(const fs_shell *s, const double *p, int32_t t, double em[3], double ec[3]);
+
+/* Work over items [i0, i1) of a whole-shell pass. */
+typedef void (*fs_shell_range_fn)(void *ctx, int32_t i0, int32_t i1);
+
+/* Runs fn over the items [0, n) on fs_threads() threads in fixed parts (energy.c design), or on the
+ * calling thread alone for few items. fn(ctx, i0, i1) must write only the slots of its own items. */
+void fs_shell_parallel(int32_t n, fs_shell_range_fn fn, void *ctx);
 
 /* Recomputes s->phi (and s->dphi when with_grad) of every hinge at positions p. */
 void fs_shell_update_phi(fs_shell *s, const double *p, bool with_grad);
@@ -290,6 +299,10 @@ void fs_shell_reserve(fs_shell *s, int32_t nodes, int32_t tris);
  * largest principal plane stress at z = +-h/2 over the face's threshold; m (may be NULL) receives
  * the unit principal direction in the face's frame (the crack's normal). NaN on failure. */
 double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2]);
+
+/* Every face's ratio at the current state into ratio (n_tris), and its direction into m (2 per face,
+ * may be NULL); updates phi first. */
+void fs_shell_face_ratios(fs_shell *s, double *ratio, double *m);
 
 /* The largest face ratio at the current state (updates phi); ratio (n_tris, may be NULL) gets each. */
 double fs_shell_max_ratio(fs_shell *s, double *ratio);

@@ -135,6 +135,8 @@ static void reserve_tris(fs_shell *s, int32_t n)
     GROW(phi, 3);
     GROW(dphi, 36);
     GROW(gphi, 3);
+    GROW(terms, 13);
+    GROW(face_ratio, 1);
     s->cap_tris = cap;
 }
 
@@ -399,6 +401,8 @@ void fs_shell_destroy(fs_shell *s)
     free(s->phi);
     free(s->dphi);
     free(s->gphi);
+    free(s->terms);
+    free(s->face_ratio);
     free(s->work);
     free(s->local.dof);
     free(s->local.in);
