@@ -715,6 +715,111 @@ static void tri_terms(void *ctx, int32_t q0, int32_t q1)
     }
 }
 
+/* design: pass 2 of an evaluation with the Hessian computes HESSIAN_CHUNK element matrices at a
+ * time on several threads (fs_shell_parallel), each into its own slot of s->ke, and adds them into
+ * the matrix on one thread in element order: the same sums as one loop, for any thread count. */
+#define HESSIAN_CHUNK 8192
+
+typedef struct {
+    fs_shell *s;
+    const fs_shell_system *sys;
+    const double *p, *gphi;
+    int32_t q0;                    /* the chunk's first scope triangle */
+} element_ctx;
+
+/* The element matrix of triangle t (its stencil's 3 k DOFs, row-major) into e, with gphi the
+ * summed dE/dphi of the hinges. */
+static void element_matrix(const fs_shell *s, const double *p, const double *gphi, int32_t t, fs_shell_element *e)
+{
+    double nu = s->cfg.material.poisson;
+    int32_t *nodes = e->nodes;
+    double *ke = e->m;
+    int loc[3], opp[3];
+    int k = e->k = stencil(s, t, nodes, loc, opp), n = 3 * k;
+    memset(ke, 0, (size_t)n * n * sizeof *ke);
+    double h = fs_shell_tri_thickness(s, t), A = s->area0[t], Y = s->young[t];
+    double km = A * h * Y, kb = A * h * h * h / 12.0 * Y, cn = 1.0 / (1.0 - nu * nu);
+    /* membrane */
+    double em[3], ec[3], sm[3], f0[3], f1[3];
+    fs_shell_elastic_strains(s, p, t, em, ec);
+    density(em, nu, sm);
+    deformation_gradient(s, p, t, f0, f1);
+    const double *di = s->dm_inv + 4 * (size_t)t;
+    double ga[3][2] = {{-di[0] - di[2], -di[1] - di[3]}, {di[0], di[1]}, {di[2], di[3]}};
+    for (int b = 0; b < 3; b++)
+        for (int kk = 0; kk < 3; kk++) {
+            /* column (b, kk): dG = sym(f_kk g_b^T), f_kk = row kk of F */
+            double fk[2] = {f0[kk], f1[kk]};
+            double dG[3] = {fk[0] * ga[b][0], fk[1] * ga[b][1], 0.5 * (fk[0] * ga[b][1] + fk[1] * ga[b][0])};
+            double tr = dG[0] + dG[1];
+            double dS[3] = {cn * ((1.0 - nu) * dG[0] + nu * tr), cn * ((1.0 - nu) * dG[1] + nu * tr),
+                            cn * (1.0 - nu) * dG[2]};
+            for (int a = 0; a < 3; a++) {
+                double sab = ga[b][0] * (sm[0] * ga[a][0] + sm[2] * ga[a][1]) +
+                             ga[b][1] * (sm[2] * ga[a][0] + sm[1] * ga[a][1]);
+                double w0 = dS[0] * ga[a][0] + dS[2] * ga[a][1], w1 = dS[2] * ga[a][0] + dS[1] * ga[a][1];
+                int row = 3 * loc[a], col = 3 * loc[b] + kk;
+                for (int r = 0; r < 3; r++)
+                    ke[(row + r) * n + col] += km * ((r == kk ? sab : 0.0) + f0[r] * w0 + f1[r] * w1);
+            }
+        }
+    /* bending: Q_ij grad phi_i grad phi_j^T */
+    int hl[3][4];
+    int32_t own[3];
+    bool live[3];
+    for (int i = 0; i < 3; i++) {
+        own[i] = fs_shell_owner(s, 3 * t + i);
+        live[i] = own[i] >= 0;
+        if (live[i])
+            hinge_local(s, own[i], nodes, k, hl[i]);
+    }
+    for (int i = 0; i < 3; i++) {
+        if (!live[i])
+            continue;
+        const double *Ti = s->bend_t + 9 * (size_t)t + 3 * i;
+        const double *dpi = s->dphi + 12 * (size_t)own[i];
+        for (int j = 0; j < 3; j++) {
+            if (!live[j])
+                continue;
+            const double *Tj = s->bend_t + 9 * (size_t)t + 3 * j;
+            double tt = Ti[0] * Tj[0] + Ti[1] * Tj[1] + 2.0 * Ti[2] * Tj[2];
+            double qq = kb * s->bend_c[3 * (size_t)t + i] * s->bend_c[3 * (size_t)t + j] * cn *
+                        ((1.0 - nu) * tt + nu * (Ti[0] + Ti[1]) * (Tj[0] + Tj[1]));
+            const double *dpj = s->dphi + 12 * (size_t)own[j];
+            for (int va = 0; va < 4; va++)
+                for (int ra = 0; ra < 3; ra++) {
+                    double wa = qq * dpi[3 * va + ra];
+                    double *row = ke + (3 * hl[i][va] + ra) * n;
+                    for (int vb = 0; vb < 4; vb++)
+                        for (int rb = 0; rb < 3; rb++)
+                            row[3 * hl[j][vb] + rb] += wa * dpj[3 * vb + rb];
+                }
+        }
+    }
+    /* the second derivatives of phi of the hinges t owns */
+    for (int i = 0; i < 3; i++) {
+        int32_t o = own[i];
+        if (!live[i] || o != 3 * t + i || gphi[o] == 0.0)
+            continue;
+        double x[12], hh[144];
+        hinge_coords(s, p, o, x);
+        fs_shell_hinge_phi(x, NULL, hh);
+        for (int va = 0; va < 4; va++)
+            for (int vb = 0; vb < 4; vb++)
+                for (int ra = 0; ra < 3; ra++)
+                    for (int rb = 0; rb < 3; rb++)
+                        ke[(3 * hl[i][va] + ra) * n + 3 * hl[i][vb] + rb] +=
+                            gphi[o] * hh[(3 * va + ra) * 12 + 3 * vb + rb];
+    }
+}
+
+static void element_range(void *ctx, int32_t i0, int32_t i1)
+{
+    const element_ctx *c = ctx;
+    for (int32_t i = i0; i < i1; i++)
+        element_matrix(c->s, c->p, c->gphi, fs_shell_scope_tri(c->sys, c->q0 + i), c->s->ke + i);
+}
+
 /* Zeroes what an evaluation over sys's scope accumulates: the gradient (g, may be NULL) at the
  * corners of its triangles and of the hinges they own, and dE/dphi (gphi, may be NULL) at those
  * hinges; everywhere for the whole shell. A local relaxation's scope is a few hundred of the
@@ -762,7 +867,6 @@ double fs_shell_energy_in(fs_shell *s, fs_shell_system *sys, const double *p, do
     bool derivs = grad || hessian;
     scope_phi(s, sys, p, derivs);
     int32_t nt = fs_shell_scope_tris(s->mesh->n_tris, sys), nn = fs_shell_scope_nodes(s->n_nodes, sys);
-    double nu = s->cfg.material.poisson;
     double energy = 0.0;
     double *g = grad;
     /* dE/dphi per edge, summed over its two triangles, for the hinges' second derivatives */
@@ -823,92 +927,26 @@ double fs_shell_energy_in(fs_shell *s, fs_shell_system *sys, const double *p, do
         return isfinite(energy) ? energy : NAN;
     }
 
-    /* pass 2: the Hessian, element by element in the pattern's order */
+    /* pass 2: the Hessian, element by element in the pattern's order (a chunk of elements' matrices
+     * at a time, on several threads, then added on one) */
     fs_sparse_matrix_zero(&sys->K);
     const int32_t *slot = sys->slots;
-    double ke[18 * 18];
-    for (int32_t q = 0; q < nt; q++) {
-        int32_t t = fs_shell_scope_tri(sys, q);
-        int32_t nodes[6], idx[18];
-        int loc[3], opp[3];
-        int k = stencil(s, t, nodes, loc, opp), n = 3 * k;
-        memset(ke, 0, (size_t)n * n * sizeof *ke);
-        double h = fs_shell_tri_thickness(s, t), A = s->area0[t], Y = s->young[t];
-        double km = A * h * Y, kb = A * h * h * h / 12.0 * Y, cn = 1.0 / (1.0 - nu * nu);
-        /* membrane */
-        double em[3], ec[3], sm[3], f0[3], f1[3];
-        fs_shell_elastic_strains(s, p, t, em, ec);
-        density(em, nu, sm);
-        deformation_gradient(s, p, t, f0, f1);
-        const double *di = s->dm_inv + 4 * (size_t)t;
-        double ga[3][2] = {{-di[0] - di[2], -di[1] - di[3]}, {di[0], di[1]}, {di[2], di[3]}};
-        for (int b = 0; b < 3; b++)
-            for (int kk = 0; kk < 3; kk++) {
-                /* column (b, kk): dG = sym(f_kk g_b^T), f_kk = row kk of F */
-                double fk[2] = {f0[kk], f1[kk]};
-                double dG[3] = {fk[0] * ga[b][0], fk[1] * ga[b][1], 0.5 * (fk[0] * ga[b][1] + fk[1] * ga[b][0])};
-                double tr = dG[0] + dG[1];
-                double dS[3] = {cn * ((1.0 - nu) * dG[0] + nu * tr), cn * ((1.0 - nu) * dG[1] + nu * tr),
-                                cn * (1.0 - nu) * dG[2]};
-                for (int a = 0; a < 3; a++) {
-                    double sab = ga[b][0] * (sm[0] * ga[a][0] + sm[2] * ga[a][1]) +
-                                 ga[b][1] * (sm[2] * ga[a][0] + sm[1] * ga[a][1]);
-                    double w0 = dS[0] * ga[a][0] + dS[2] * ga[a][1], w1 = dS[2] * ga[a][0] + dS[1] * ga[a][1];
-                    int row = 3 * loc[a], col = 3 * loc[b] + kk;
-                    for (int r = 0; r < 3; r++)
-                        ke[(row + r) * n + col] += km * ((r == kk ? sab : 0.0) + f0[r] * w0 + f1[r] * w1);
-                }
-            }
-        /* bending: Q_ij grad phi_i grad phi_j^T */
-        int hl[3][4];
-        int32_t own[3];
-        bool live[3];
-        for (int i = 0; i < 3; i++) {
-            own[i] = fs_shell_owner(s, 3 * t + i);
-            live[i] = own[i] >= 0;
-            if (live[i])
-                hinge_local(s, own[i], nodes, k, hl[i]);
+    int32_t chunk = nt < HESSIAN_CHUNK ? nt : HESSIAN_CHUNK;
+    if (s->ke_cap < chunk) {
+        free(s->ke);
+        s->ke = fs_malloc((size_t)chunk * sizeof *s->ke);
+        s->ke_cap = chunk;
+    }
+    for (int32_t q0 = 0; q0 < nt; q0 += chunk) {
+        int32_t q1 = nt - q0 < chunk ? nt : q0 + chunk;
+        element_ctx ec = {s, sys, p, gphi, q0};
+        fs_shell_parallel(q1 - q0, element_range, &ec);
+        for (int32_t q = q0; q < q1; q++) {
+            const fs_shell_element *e = s->ke + (q - q0);
+            int32_t idx[18];
+            block_dofs(sys, e->nodes, e->k, idx);
+            slot += fs_sparse_matrix_add_block(&sys->K, 3 * e->k, idx, e->m, slot);
         }
-        for (int i = 0; i < 3; i++) {
-            if (!live[i])
-                continue;
-            const double *Ti = s->bend_t + 9 * (size_t)t + 3 * i;
-            const double *dpi = s->dphi + 12 * (size_t)own[i];
-            for (int j = 0; j < 3; j++) {
-                if (!live[j])
-                    continue;
-                const double *Tj = s->bend_t + 9 * (size_t)t + 3 * j;
-                double tt = Ti[0] * Tj[0] + Ti[1] * Tj[1] + 2.0 * Ti[2] * Tj[2];
-                double qq = kb * s->bend_c[3 * (size_t)t + i] * s->bend_c[3 * (size_t)t + j] * cn *
-                            ((1.0 - nu) * tt + nu * (Ti[0] + Ti[1]) * (Tj[0] + Tj[1]));
-                const double *dpj = s->dphi + 12 * (size_t)own[j];
-                for (int va = 0; va < 4; va++)
-                    for (int ra = 0; ra < 3; ra++) {
-                        double wa = qq * dpi[3 * va + ra];
-                        double *row = ke + (3 * hl[i][va] + ra) * n;
-                        for (int vb = 0; vb < 4; vb++)
-                            for (int rb = 0; rb < 3; rb++)
-                                row[3 * hl[j][vb] + rb] += wa * dpj[3 * vb + rb];
-                    }
-            }
-        }
-        /* the second derivatives of phi of the hinges t owns */
-        for (int i = 0; i < 3; i++) {
-            int32_t e = own[i];
-            if (!live[i] || e != 3 * t + i || gphi[e] == 0.0)
-                continue;
-            double x[12], hh[144];
-            hinge_coords(s, p, e, x);
-            fs_shell_hinge_phi(x, NULL, hh);
-            for (int va = 0; va < 4; va++)
-                for (int vb = 0; vb < 4; vb++)
-                    for (int ra = 0; ra < 3; ra++)
-                        for (int rb = 0; rb < 3; rb++)
-                            ke[(3 * hl[i][va] + ra) * n + 3 * hl[i][vb] + rb] +=
-                                gphi[e] * hh[(3 * va + ra) * 12 + 3 * vb + rb];
-        }
-        block_dofs(sys, nodes, k, idx);
-        slot += fs_sparse_matrix_add_block(&sys->K, n, idx, ke, slot);
     }
     for (int32_t q = 0; q < nn; q++) {
         int32_t i = fs_shell_scope_node(sys, q);

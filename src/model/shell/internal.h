@@ -66,6 +66,13 @@ typedef struct {
     double assemble_seconds, factor_seconds, solve_seconds, fracture_seconds;
 } fs_shell_counters;
 
+/* One element's Hessian block: the nodes of its stencil (k of them) and its 3 k x 3 k matrix. */
+typedef struct {
+    int32_t nodes[6];
+    int k;
+    double m[18 * 18];
+} fs_shell_element;
+
 /* A Newton system over some of the shell's DOFs: the whole shell, or the nodes around a change for a
  * local relaxation (shell/relax.c), whose energy is then summed over the triangles and bonds that
  * depend on those nodes (the rest of the energy is constant while only they move). */
@@ -180,6 +187,8 @@ struct fs_shell {
     double *gphi;                  /* 3 per triangle, at owners: dE/dphi (scratch of the Hessian) */
     double *terms;                 /* 13 per triangle: its energy terms (scratch of an evaluation) */
     double *face_ratio;            /* per triangle: its fracture ratio (scratch of fs_shell_max_ratio) */
+    fs_shell_element *ke;          /* element matrices of a chunk of a Hessian's assembly (scratch) */
+    int32_t ke_cap;
 
     fs_shell_system sys;           /* the whole shell's system (no scope) */
     double *grad;                  /* 3 per node: gradient of the energy at x */

@@ -403,6 +403,7 @@ void fs_shell_destroy(fs_shell *s)
     free(s->gphi);
     free(s->terms);
     free(s->face_ratio);
+    free(s->ke);
     free(s->work);
     free(s->local.dof);
     free(s->local.in);
