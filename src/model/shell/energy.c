@@ -486,17 +486,15 @@ static int32_t pair_base(const int32_t *own, const int32_t *nb_start, const neig
     return nb[lo].before;
 }
 
-/* The first DOF of each of the k stencil nodes, -1 for a node without one. */
-static void stencil_firsts(const fs_shell_system *sys, const int32_t *first, const int32_t *nodes, int k,
-                           int32_t fr[6])
+/* The first DOF of each of the kn nodes of a block over idx (3 DOFs a node, -1 held), -1 for a node
+ * without one. */
+static void block_firsts(const int32_t *first, const int32_t *idx, int kn, int32_t fn[6])
 {
-    for (int q = 0; q < k; q++) {
-        fr[q] = -1;
-        for (int c = 0; c < 3 && fr[q] < 0; c++) {
-            int32_t d = sys->dof[3 * (size_t)nodes[q] + c];
-            if (d >= 0)
-                fr[q] = first[d];
-        }
+    for (int i = 0; i < kn; i++) {
+        fn[i] = -1;
+        for (int c = 0; c < 3 && fn[i] < 0; c++)
+            if (idx[3 * i + c] >= 0)
+                fn[i] = first[idx[3 * i + c]];
     }
 }
 
@@ -516,12 +514,7 @@ static int32_t *block_slots(const fs_sparse_matrix *K, const int32_t *first, con
 {
     int32_t fn[6], base[6][6];
     int kn = k / 3;
-    for (int i = 0; i < kn; i++) {
-        fn[i] = -1;
-        for (int c = 0; c < 3 && fn[i] < 0; c++)
-            if (idx[3 * i + c] >= 0)
-                fn[i] = first[idx[3 * i + c]];
-    }
+    block_firsts(first, idx, kn, fn);
     for (int i = 0; i < kn; i++)
         for (int j = i; j < kn; j++)
             if (fn[i] >= 0 && fn[j] >= 0)
@@ -570,12 +563,13 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
     int32_t *st = fs_malloc(6 * ((size_t)nt + 1) * sizeof *st);
     size_t n_slots = 6 * (size_t)nn;
     for (int32_t q = 0; q < nt; q++) {
-        int32_t *nodes = st + 6 * (size_t)q, fr[6];
+        int32_t *nodes = st + 6 * (size_t)q, fr[6], idx[18];
         int loc[3], opp[3];
         int k = stencil(s, fs_shell_scope_tri(sys, q), nodes, loc, opp);
         for (int a = k; a < 6; a++)
             nodes[a] = -1;
-        stencil_firsts(sys, first, nodes, k, fr);
+        block_dofs(sys, nodes, k, idx);
+        block_firsts(first, idx, k, fr);
         n_slots += (size_t)(3 * k) * (size_t)(3 * k + 1) / 2;
         for (int a = 0; a < k; a++)
             for (int b = 0; b < k; b++)
@@ -589,9 +583,10 @@ static int build_pattern(fs_shell *s, fs_shell_system *sys)
     memcpy(cursor, nb_start, (size_t)nf * sizeof *cursor);
     for (int32_t q = 0; q < nt; q++) {
         const int32_t *nodes = st + 6 * (size_t)q;
-        int32_t fr[6];
+        int32_t fr[6], idx[18];
         int k = stencil_size(nodes);
-        stencil_firsts(sys, first, nodes, k, fr);
+        block_dofs(sys, nodes, k, idx);
+        block_firsts(first, idx, k, fr);
         for (int a = 0; a < k; a++)
             for (int b = 0; b < k; b++)
                 if (fr[a] >= 0 && fr[a] < fr[b])
