@@ -49,13 +49,21 @@ grep -qF "missing.obj: cannot open the mesh" "$tmp/stderr" || not_ok "the missin
 # Along every interior edge, the runs of crack just inside one side are matched with crack just
 # inside the other side; the seams must match about as well as the ordinary edges do (the
 # measure misses a crack that ends at an edge or leaves a short edge's window, on either kind).
-expect_status 0 "glaze on a coarse vase runs" "$FISSURE" -q -o "$tmp/seam" -n x --size 1024x1024 --maps crackmask \
-    --set domain.file="$top_srcdir/tests/vase-coarse.obj" glaze
-set -- $("$(dirname "$FISSURE")/tests/seam_check" "$top_srcdir/tests/vase-coarse.obj" "$tmp/seam/x_crackmask.png")
-if [ "${2:-0}" -ge 10 ] && awk_true "${3:-0} / ${2:-1} >= ${6:-0} / ${5:-1} - 0.15"; then
-    ok "cracks continue across UV seams ($3 of $2 runs on $1 seam edges; $6 of $5 on $4 other edges)"
+# One run gives some 35 runs on seams, whose matched share varies by 0.1 from seed to seed (0.35 to
+# 0.59 over seeds 1-4, against 0.48 to 0.55 elsewhere), so seeds 1-3 are pooled.
+seam_runs=0 seam_matched=0 other_runs=0 other_matched=0 seam_edges=0 other_edges=0
+for seed in 1 2 3; do
+    expect_status 0 "glaze on a coarse vase runs (seed $seed)" "$FISSURE" -q -s $seed -o "$tmp/seam-$seed" -n x \
+        --size 1024x1024 --maps crackmask --set domain.file="$top_srcdir/tests/vase-coarse.obj" glaze
+    set -- $("$(dirname "$FISSURE")/tests/seam_check" "$top_srcdir/tests/vase-coarse.obj" "$tmp/seam-$seed/x_crackmask.png")
+    seam_edges=${1:-0} other_edges=${4:-0}
+    seam_runs=$((seam_runs + ${2:-0})) seam_matched=$((seam_matched + ${3:-0}))
+    other_runs=$((other_runs + ${5:-0})) other_matched=$((other_matched + ${6:-0}))
+done
+if [ "$seam_runs" -ge 30 ] && awk_true "$seam_matched / $seam_runs >= $other_matched / ($other_runs + 1e-9) - 0.15"; then
+    ok "cracks continue across UV seams ($seam_matched of $seam_runs runs on $seam_edges seam edges; $other_matched of $other_runs on $other_edges other edges, seeds 1-3)"
 else
-    not_ok "cracks continue across UV seams (got '$3' of '$2' runs on seams; '$6' of '$5' elsewhere)"
+    not_ok "cracks continue across UV seams (got $seam_matched of $seam_runs runs on seams; $other_matched of $other_runs elsewhere)"
 fi
 # The same thin layer (0.25 cm, E 10 MPa, threshold 100 kPa, shrinking 3 % through its thickness on a
 # periodic 3 x 3 cm tile, 2250 triangles) as a bonded shell and as a wedge layer held at its bottom:

@@ -6,7 +6,7 @@ EDGES="$(dirname "$FISSURE")/tests/tile_edges"
     && ok "voronoi-tile runs" || not_ok "voronoi-tile runs"
 for map in height basecolor crackmask normal; do
     # tile_edges exits 0 when the seam (last->first column and row) differs no more than 1.5 times the
-    # mean difference between neighbouring columns and rows inside the image.
+    # larger difference of the neighbouring pairs of columns (rows) on either side of it.
     "$EDGES" xy "$tmp/t/t_$map.png" > "$tmp/edges" && ok "$map tiles in x and y: $(cat "$tmp/edges")" \
         || not_ok "$map tiles in x and y: $(cat "$tmp/edges")"
 done

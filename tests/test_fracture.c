@@ -9,6 +9,7 @@
 #include "fracture/eigen.h"
 #include "fracture/event.h"
 #include "fracture/rank.h"
+#include "base/vec.h"
 #include "fracture/separation.h"
 
 /* ---- eigen ---- */
@@ -620,6 +621,105 @@ static void test_nodal_principal_plane(void)
     fs_error_clear();
 }
 
+/* The near-tip field of a crack along -x with its tip at the origin (Williams; tensor shears, z = 0)
+ * for stress intensities ki (opening) and kii (sliding), at polar (r, theta). */
+static void tip_field(double r, double theta, double ki, double kii, double s[6])
+{
+    double c = 1.0 / sqrt(2.0 * FS_PI * r), h = theta / 2.0, t3 = 1.5 * theta;
+    s[0] = c * (ki * cos(h) * (1.0 - sin(h) * sin(t3)) - kii * sin(h) * (2.0 + cos(h) * cos(t3)));
+    s[1] = c * (ki * cos(h) * (1.0 + sin(h) * sin(t3)) + kii * sin(h) * cos(h) * cos(t3));
+    s[3] = c * (ki * cos(h) * sin(h) * cos(t3) + kii * cos(h) * (1.0 - sin(h) * sin(t3)));
+    s[2] = s[4] = s[5] = 0.0;
+}
+
+/* The angle (radians, from +x) a crack arriving along +x turns to under the tip stress averaged over
+ * the tip field on a polar grid, with the unloaded walls' stress along the crack behind the tip. */
+static double tip_turn(double ki, double kii)
+{
+    const double ahead[3] = {2.0, 0.0, 0.0}; /* any length */
+    fs_tip_stress avg;
+    fs_tip_stress_begin(&avg, ahead, NULL, 1.0);
+    for (int i = 1; i <= 200; i++)
+        for (int j = 0; j < 72; j++) {
+            double r = 0.02 * i, theta = -FS_PI + (j + 0.5) * (2.0 * FS_PI / 72.0), s[6];
+            double at[3] = {r * cos(theta), r * sin(theta), 0.0};
+            if (fabs(theta) < FS_PI / 2.0)
+                tip_field(r, theta, ki, kii, s);
+            else /* the walls behind the tip: stress along the crack only */
+                for (int k = 0; k < 6; k++)
+                    s[k] = k == 0 ? 50.0 : 0.0;
+            fs_tip_stress_add(&avg, at, NULL, r, s);
+        }
+    double mean[6], sigma1, m[3];
+    CHECK(fs_tip_stress_mean(&avg, mean));
+    CHECK(fs_nodal_principal_plane(mean, &sigma1, m) == 0 && sigma1 > 0.0);
+    double turn = atan2(m[1], m[0]) - FS_PI / 2.0; /* the crack runs normal to m */
+    return turn < -FS_PI / 2.0 ? turn + FS_PI : turn;
+}
+
+/* The tip stress steers as fracture mechanics says: under pure opening (mode I) the crack runs
+ * straight on, whatever the walls behind the tip carry; with a sliding part (mode II) it turns to the
+ * side the maximum hoop stress criterion turns it to, by a little less (the average of the field
+ * ahead lags its maximum: 0.55 to 0.65 of the criterion's angle for K_II / K_I from 0.1 to 0.5). Samples
+ * behind the tip, beyond 3 radii or without size do not count; no sample gives no mean. */
+static void test_tip_stress(void)
+{
+    CHECK_NEAR(tip_turn(1.0, 0.0), 0.0, 1e-6); /* the grid's rounding */
+    for (double q = 0.1; q < 0.6; q += 0.2) {
+        double mts = 2.0 * atan((1.0 - sqrt(1.0 + 8.0 * q * q)) / (4.0 * q)), turn = tip_turn(1.0, q);
+        CHECK(turn < 0.0 && mts < 0.0);
+        CHECK(turn / mts > 0.5 && turn / mts < 0.75);
+    }
+    fs_tip_stress avg;
+    const double ahead[3] = {0.0, 1.0, 0.0}, s[6] = {1, 2, 3, 4, 5, 6};
+    double mean[6];
+    fs_tip_stress_begin(&avg, ahead, NULL, 0.5);
+    CHECK(!fs_tip_stress_mean(&avg, mean) && mean[0] == 0.0);
+    const double behind[3] = {0.0, -0.1, 0.0}, beside[3] = {1.0, 0.0, 0.0}, far[3] = {0.0, 1.6, 0.0};
+    const double near[3] = {0.0, 0.2, 0.0};
+    fs_tip_stress_add(&avg, behind, NULL, 1.0, s);
+    fs_tip_stress_add(&avg, beside, NULL, 1.0, s);
+    fs_tip_stress_add(&avg, far, NULL, 1.0, s);
+    fs_tip_stress_add(&avg, near, NULL, 0.0, s);
+    CHECK(!fs_tip_stress_mean(&avg, mean));
+    fs_tip_stress_add(&avg, near, NULL, 2.0, s);
+    CHECK(fs_tip_stress_mean(&avg, mean));
+    for (int k = 0; k < 6; k++)
+        CHECK_NEAR(mean[k], s[k], 1e-15);
+}
+
+/* On a curved layer a sample's stress is turned into the tip's tangent plane: tension along the
+ * sample's own tangent y' = (0, cos 30, sin 30), on a face tilted 30 degrees about x, pulls along y
+ * at a tip whose normal is z, and the plane is across the layer (no z in it); untilted it would
+ * lean half out of the layer. A sample 60 degrees off or more does not count, and the mean is
+ * projected onto the tangent plane. */
+static void test_tip_stress_surface(void)
+{
+    const double ahead[3] = {1.0, 0.0, 0.0}, tip_normal[3] = {0.0, 0.0, 1.0}, at[3] = {0.5, 0.0, 0.0};
+    double c = cos(FS_PI / 6.0), sn = sin(FS_PI / 6.0);
+    const double tilted[3] = {0.0, -sn, c}, y1[3] = {0.0, c, sn};
+    const double s[6] = {0.0, y1[1] * y1[1], y1[2] * y1[2], 0.0, y1[1] * y1[2], 0.0};
+    fs_tip_stress avg;
+    double mean[6], sigma1, m[3];
+    fs_tip_stress_begin(&avg, ahead, tip_normal, 1.0);
+    fs_tip_stress_add(&avg, at, tilted, 1.0, s);
+    CHECK(fs_tip_stress_mean(&avg, mean));
+    CHECK(fs_nodal_principal_plane(mean, &sigma1, m) == 0);
+    CHECK_NEAR(sigma1, 1.0, 1e-12);
+    CHECK_NEAR(fabs(m[1]), 1.0, 1e-12);
+    CHECK_NEAR(m[2], 0.0, 1e-12);
+    const double steep[3] = {0.0, -sin(FS_PI / 2.8), cos(FS_PI / 2.8)}; /* 64 degrees */
+    fs_tip_stress_begin(&avg, ahead, tip_normal, 1.0);
+    fs_tip_stress_add(&avg, at, steep, 1.0, s);
+    CHECK(!fs_tip_stress_mean(&avg, mean));
+    /* the normal's share is projected out: sigma_zz and the z shears vanish */
+    const double full[6] = {1, 2, 3, 4, 5, 6};
+    fs_tip_stress_add(&avg, at, NULL, 1.0, full);
+    CHECK(fs_tip_stress_mean(&avg, mean));
+    CHECK(mean[0] == 1.0 && mean[1] == 2.0 && mean[3] == 4.0);
+    CHECK(mean[2] == 0.0 && mean[4] == 0.0 && mean[5] == 0.0);
+}
+
 /* Eq. 28: m(a) has eigenvalue |a| along a, 0 across it; m(0) = 0. */
 static void test_separation_m(void)
 {
@@ -778,6 +878,8 @@ int main(void)
     RUN(test_principal_stress);
     RUN(test_principal_bound);
     RUN(test_nodal_principal_plane);
+    RUN(test_tip_stress);
+    RUN(test_tip_stress_surface);
     RUN(test_separation_m);
     RUN(test_separation_split_stress);
     RUN(test_separation_tensor_cases);

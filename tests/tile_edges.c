@@ -1,4 +1,4 @@
-/* Test helper: does an image continue across its opposite edges as smoothly as it does inside? */
+/* Test helper: does an image continue across its opposite edges as smoothly as it does beside them? */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -29,15 +29,16 @@ static double line_diff(const fs_image *img, int rows, int a, int b)
     return sum / (n * img->channels);
 }
 
-/* Ratio of the seam difference to the mean difference of neighbouring lines inside. */
+/* Ratio of the seam difference (last line to first) to the larger of the differences of the line
+ * pairs on either side of it (the last two lines, the first two). Across a seamless edge the image
+ * changes as it does beside it: a crack lying along the seam shows in its neighbours' differences
+ * too, where a mean over the whole image would take it for a seam; a picture that does not wrap
+ * changes several times more across the edge than beside it. */
 static double seam_ratio(const fs_image *img, int rows)
 {
     int n = rows ? img->height : img->width;
-    double inside = 0;
-    for (int k = 0; k + 1 < n; k++)
-        inside += line_diff(img, rows, k, k + 1);
-    inside /= n - 1;
-    return line_diff(img, rows, n - 1, 0) / (inside > 1e-12 ? inside : 1e-12);
+    double beside = fmax(line_diff(img, rows, n - 2, n - 1), line_diff(img, rows, 0, 1));
+    return line_diff(img, rows, n - 1, 0) / (beside > 1e-12 ? beside : 1e-12);
 }
 
 int main(int argc, char **argv)
@@ -54,12 +55,12 @@ int main(int argc, char **argv)
     int ok = 1;
     if (strchr(argv[1], 'x')) {
         double r = seam_ratio(&img, 0);
-        printf("x seam/inside = %.3f ", r);
+        printf("x seam/beside = %.3f ", r);
         ok &= r <= 1.5;
     }
     if (strchr(argv[1], 'y')) {
         double r = seam_ratio(&img, 1);
-        printf("y seam/inside = %.3f ", r);
+        printf("y seam/beside = %.3f ", r);
         ok &= r <= 1.5;
     }
     printf("\n");

@@ -40,6 +40,47 @@ void fs_nodal_stress_add(fs_nodal_stress *a, const double s[6]);
  * zeroed) when none were. */
 bool fs_nodal_stress_mean(const fs_nodal_stress *a, double mean[6]);
 
+/* design: the direction a crack tip runs in. The stress of the element just ahead of a tip varies
+ * from element to element on the scale of the mesh (a coarse mesh resolves the tip's concentration
+ * in whichever element it happens to fall), and a crack that follows each element's own principal
+ * plane zigzags with the elements. The tip stress instead averages the stress samples in front of
+ * the tip (offset o from the tip with o . ahead > 0, ahead the direction the crack travelled) with
+ * the weight size * exp(-(|o| / radius)^2), the nonlocal average by which continuum fracture codes
+ * steer their cracks: on a symmetric (mode I) field ahead of a tip the shears cancel and the crack
+ * runs straight on; a mixed-mode field turns it, on the scale of the radius rather than of one
+ * element. Samples behind the tip (the unloaded crack walls, whose stress along the crack would turn
+ * it aside) and beyond 3 radii do not count.
+ *
+ * On a curved layer (a sphere, a trunk, a shell) each sample's stress lies in its own tangent plane:
+ * it is turned into the tip's by the smallest rotation that takes the sample's surface normal onto
+ * the tip's (parallel transport, exact for a sphere), samples whose normal is 60 degrees or more
+ * from the tip's do not count, and the mean is projected onto the tip's tangent plane, so the plane
+ * it gives is across the layer. */
+
+/* The running weighted mean of the stresses ahead of a crack tip. Start it with fs_tip_stress_begin. */
+typedef struct {
+    double sum[6];
+    double weight;
+    double ahead[3], radius;
+    double normal[3];
+    bool surface;
+} fs_tip_stress;
+
+/* Starts the mean for a tip whose crack travelled along ahead (3-D, any length) with the averaging
+ * radius radius (> 0, the model's length unit); normal is the surface's unit normal at the tip, or
+ * NULL for a volume (no turning, no projection). */
+void fs_tip_stress_begin(fs_tip_stress *a, const double ahead[3], const double normal[3], double radius);
+
+/* Adds the stress s (Voigt) of a sample at offset (3-D, from the tip) standing for size (an area or
+ * volume, >= 0) of material; normal is the surface's unit normal at the sample (may be NULL: taken
+ * as the tip's). */
+void fs_tip_stress_add(fs_tip_stress *a, const double offset[3], const double normal[3], double size,
+                       const double s[6]);
+
+/* The weighted mean into mean (on a surface, projected onto the tip's tangent plane); false (mean
+ * zeroed) when no sample ahead of the tip had weight. */
+bool fs_tip_stress_mean(const fs_tip_stress *a, double mean[6]);
+
 /* The largest principal stress of a Voigt stress into *sigma1 and, if normal is not NULL, the unit
  * normal of its principal plane (the eigenvector of sigma1, oriented as fs_eigen_sym3 orients it).
  * Returns 0, or -1 with fs_error (FS_ERR_INTERNAL) if an entry is not finite (outputs zeroed). */

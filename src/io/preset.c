@@ -126,6 +126,8 @@ static const key_def key_table[] = {
      "edge lengths"},
     {"fracture", "tip_submodel_size", KEY_REAL, OFF(fracture.tip_submodel_size), 0.01, 1, GE | LE, NULL,
      "edge lengths"},
+    {"fracture", "direction_radius", KEY_REAL, OFF(fracture.direction_radius), 0, 10, GE | LE, NULL,
+     "edge lengths"},
 
     {"time", "end", KEY_REAL, OFF(time.end), 0, 0, GT, NULL, NULL},
     {"time", "min_step", KEY_REAL, OFF(time.min_step), 0, 0, GT, NULL, NULL},

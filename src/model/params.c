@@ -24,6 +24,7 @@ fs_fracture_params fs_fracture_params_default(void)
         .tip_submodel = false,
         .tip_submodel_radius = 4.0,
         .tip_submodel_size = 0.25,
+        .direction_radius = 1.5,
     };
 }
 

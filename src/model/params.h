@@ -40,9 +40,13 @@ typedef struct {
     double tip_submodel_radius; /* its radius, in mean edge lengths */
     double tip_submodel_size;   /* the size (longest edge) it refines the tip's vicinity to, in mean
                                    edge lengths */
+    double direction_radius;    /* split: the radius of the stress average ahead of a tip that sets
+                                   the way it runs (fs_tip_stress), in mean edge lengths; 0: the
+                                   stress of the tip's most loaded element alone */
 } fs_fracture_params;
 
-/* Splitting, Griffith on, no tip sub-model (radius 4, size 0.25 when on). */
+/* Splitting, Griffith on, no tip sub-model (radius 4, size 0.25 when on), tip directions averaged
+ * over 1.5 edge lengths. */
 fs_fracture_params fs_fracture_params_default(void);
 
 /* [time] */

@@ -11,6 +11,7 @@
 #include "base/rng.h"
 #include "base/vec.h"
 #include "fracture/rank.h"
+#include "fracture/separation.h"
 #include "fracture/split.h"
 #include "geom/cut.h"
 
@@ -557,21 +558,127 @@ static int32_t ray_end(fs_shell *s, face_cut *fc, const ray_hit *h)
     return w;
 }
 
+/* The stresses the faces had at the batch's equilibrium (fs_shell_face_ratios): faces from n on are
+ * the batch's own and have none. */
+typedef struct {
+    const double *stress;
+    int32_t n;
+} face_stresses;
+
+/* The unit normal of face t in the rest shape, by its corners' order, into normal; returns its area. */
+static double face_normal(const fs_shell *s, int32_t t, double normal[3])
+{
+    double p[3][3], ab[3], ac[3];
+    for (int k = 0; k < 3; k++)
+        fs_shell_corner(s, s->rest, t, k, p[k]);
+    fs_sub3(ab, p[1], p[0]);
+    fs_sub3(ac, p[2], p[0]);
+    fs_cross3(normal, ab, ac);
+    double twice = fs_norm3(normal);
+    for (int j = 0; j < 3 && twice > 0.0; j++)
+        normal[j] /= twice;
+    return 0.5 * twice;
+}
+
+static int32_t find_in(const int32_t *list, int32_t n, int32_t x)
+{
+    for (int32_t k = 0; k < n; k++)
+        if (list[k] == x)
+            return k;
+    return -1;
+}
+
+/* The fracture plane normal m (3-D, unit) that steers the crack of tip v: the principal plane of the
+ * stress averaged ahead of v (fs_tip_stress, the crack arrived along tip_dir[v]) over the faces the
+ * material connects to v within 3 radii of it (in the rest shape), each at its centroid with its
+ * rest area. False when [fracture] direction_radius is 0 or the average pulls on no plane: then the
+ * face's own direction stands. */
+static bool tip_average_plane(const fs_shell *s, face_cut *fc, const face_stresses *fs, int32_t v, const double normal[3],
+                              double m[3])
+{
+    double radius = s->cfg.fracture.direction_radius * s->unit;
+    if (!(radius > 0.0))
+        return false;
+    const fs_mesh *mesh = s->mesh;
+    int32_t *nodes = NULL, *faces = NULL, n_nodes = 0, n_faces = 0, cap_nodes = 0, cap_faces = 0;
+    double *offset = NULL; /* 3 per entry of nodes: its rest position from v, periods unwrapped */
+    FS_ARRAY_RESERVE(nodes, cap_nodes, 1, 32);
+    offset = fs_realloc(offset, 3 * (size_t)cap_nodes * sizeof *offset);
+    nodes[n_nodes++] = v;
+    offset[0] = offset[1] = offset[2] = 0.0;
+    fs_tip_stress avg;
+    fs_tip_stress_begin(&avg, s->tip_dir + 3 * (size_t)v, normal, radius);
+    for (int32_t q = 0; q < n_nodes; q++) {
+        int32_t n = fan_of(&fc->cut, nodes[q], &fc->fan, &fc->cap);
+        for (int32_t i = 0; i < n; i++) {
+            int32_t t = fc->fan[i];
+            if (t >= fs->n || find_in(faces, n_faces, t) >= 0)
+                continue;
+            FS_ARRAY_RESERVE(faces, cap_faces, n_faces + 1, 32);
+            faces[n_faces++] = t;
+            double p[3][3], from[3], centroid[3] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < 3; k++)
+                fs_shell_corner(s, s->rest, t, k, p[k]);
+            memcpy(from, p[fs_mesh_corner_of(mesh, t, nodes[q])], sizeof from);
+            for (int k = 0; k < 3; k++) {
+                double off[3];
+                for (int j = 0; j < 3; j++) {
+                    off[j] = offset[3 * (size_t)q + j] + p[k][j] - from[j];
+                    centroid[j] += off[j] / 3.0;
+                }
+                int32_t u = mesh->tri[3 * (size_t)t + k];
+                if (fs_norm3(off) <= 3.0 * radius && find_in(nodes, n_nodes, u) < 0) {
+                    int32_t old_cap = cap_nodes;
+                    FS_ARRAY_RESERVE(nodes, cap_nodes, n_nodes + 1, 32);
+                    if (cap_nodes != old_cap)
+                        offset = fs_realloc(offset, 3 * (size_t)cap_nodes * sizeof *offset);
+                    memcpy(offset + 3 * (size_t)n_nodes, off, sizeof off);
+                    nodes[n_nodes++] = u;
+                }
+            }
+            double normal_t[3];
+            double area = face_normal(s, t, normal_t);
+            fs_tip_stress_add(&avg, centroid, normal_t, area, fs->stress + 6 * (size_t)t);
+        }
+    }
+    free(nodes);
+    free(faces);
+    free(offset);
+    double mean[6], sigma1;
+    if (!fs_tip_stress_mean(&avg, mean))
+        return false;
+    if (fs_nodal_principal_plane(mean, &sigma1, m) < 0) {
+        fs_error_clear();
+        return false;
+    }
+    return sigma1 > 0.0;
+}
+
 /* The start of face f's crack: a corner that is a crack tip whose continuation (the ray of the crack
  * line on the way the crack came) leaves through its fan; else the middle corner along the principal
  * direction, with the ray into f first and, when that corner is inside the material, the opposite
  * ray. Fills rays and returns how many (the start in *v0). */
-static int crack_start(const fs_shell *s, face_cut *fc, int32_t f, const double mdir[2], const double dir[3],
-                       int32_t *v0, double rays[2][3])
+static int crack_start(const fs_shell *s, face_cut *fc, const face_stresses *fs, int32_t f, const double mdir[2],
+                       const double dir[3], int32_t *v0, double rays[2][3])
 {
     const fs_mesh *m = s->mesh;
     for (int k = 0; k < 3; k++) {
         int32_t v = m->tri[3 * (size_t)f + k];
         if (!is_tip(s, v))
             continue;
-        double sign = fs_dot3(dir, s->tip_dir + 3 * (size_t)v) < 0.0 ? -1.0 : 1.0;
+        double line[3], plane[3], normal[3];
+        memcpy(line, dir, sizeof line);
+        const double *e1 = s->frame + 6 * (size_t)f, *e2 = e1 + 3;
+        face_normal(s, f, normal);
+        if (tip_average_plane(s, fc, fs, v, normal, plane)) {
+            /* the averaged plane's trace in f */
+            const double in_f[2] = {fs_dot3(plane, e1), fs_dot3(plane, e2)};
+            if (hypot(in_f[0], in_f[1]) > 1e-6)
+                crack_line(s, f, in_f, line);
+        }
+        double sign = fs_dot3(line, s->tip_dir + 3 * (size_t)v) < 0.0 ? -1.0 : 1.0;
         for (int q = 0; q < 3; q++)
-            rays[0][q] = sign * dir[q];
+            rays[0][q] = sign * line[q];
         int32_t n = fan_of(&fc->cut, v, &fc->fan, &fc->cap);
         ray_hit h;
         if (cast_ray(s, v, rays[0], fc->fan, n, &h) != FS_SPLIT_MISS) {
@@ -627,8 +734,8 @@ static void changed_nodes(const fs_shell *s, const fs_cut *c, int32_t **out, int
 /* Cuts face f along its crack line; the nodes it changed the surroundings of are appended to *touched
  * (count *n_touched, capacity *cap_touched). Returns 1 if a crack opened, 0 if nothing changed, -1 on
  * failure. */
-static int cut_face(fs_shell *s, int32_t f, const double mdir[2], int32_t **touched, int32_t *n_touched,
-                    int32_t *cap_touched)
+static int cut_face(fs_shell *s, const face_stresses *fs, int32_t f, const double mdir[2], int32_t **touched,
+                    int32_t *n_touched, int32_t *cap_touched)
 {
     fs_mesh *m = s->mesh;
     double dir[3], rays[2][3];
@@ -637,7 +744,7 @@ static int cut_face(fs_shell *s, int32_t f, const double mdir[2], int32_t **touc
     memset(&fc, 0, sizeof fc);
     fs_cut_begin(&fc.cut, m, NULL, NULL);
     int32_t v0;
-    int n_rays = crack_start(s, &fc, f, mdir, dir, &v0, rays);
+    int n_rays = crack_start(s, &fc, fs, f, mdir, dir, &v0, rays);
     int32_t ends[2];
     double end_dir[2][3];
     int n_ends = 0, rc = 0;
@@ -701,7 +808,9 @@ int32_t fs_shell_fracture_batch(fs_shell *s, int32_t **seeds, int32_t *n_seeds)
     int32_t n = s->n_tris;
     double *ratio = fs_malloc(((size_t)n + 1) * sizeof *ratio);
     double *mdir = fs_malloc(2 * ((size_t)n + 1) * sizeof *mdir);
-    fs_shell_face_ratios(s, ratio, mdir);
+    double *stress = fs_malloc(6 * ((size_t)n + 1) * sizeof *stress);
+    fs_shell_face_ratios(s, ratio, mdir, stress);
+    const face_stresses stresses = {stress, n};
     int32_t n_cand = 0;
     int32_t *cand = fs_malloc(((size_t)n + 1) * sizeof *cand);
     for (int32_t t = 0; t < n; t++)
@@ -735,7 +844,7 @@ int32_t fs_shell_fracture_batch(fs_shell *s, int32_t **seeds, int32_t *n_seeds)
         if (near)
             continue;
         int32_t from = n_changed;
-        int rc = cut_face(s, f, mdir + 2 * (size_t)f, &changed, &n_changed, &cap_changed);
+        int rc = cut_face(s, &stresses, f, mdir + 2 * (size_t)f, &changed, &n_changed, &cap_changed);
         if (rc < 0) {
             cuts = -1;
             break;
@@ -763,6 +872,7 @@ int32_t fs_shell_fracture_batch(fs_shell *s, int32_t **seeds, int32_t *n_seeds)
     free(near_mark);
     free(ratio);
     free(mdir);
+    free(stress);
     free(cand);
     free(cr);
     free(cid);

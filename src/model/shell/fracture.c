@@ -45,7 +45,11 @@ static void bond_shear(const fs_shell *s, int32_t t, double d[3])
         d[k] = ex[k] - ea[k];
 }
 
-double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2])
+/* The plane stress (xx, yy, xy in face t's rest frame) of the elastic strains at the side of t the
+ * criterion reads that is the more loaded (see the design note), into plane, and its largest
+ * principal stress, or NaN for a stress that is not finite; m (may be NULL) receives the principal
+ * direction, in the frame. */
+static double critical_stress(const fs_shell *s, int32_t t, double plane[3], double m[2])
 {
     double em[3], ec[3];
     fs_shell_elastic_strains(s, s->x, t, em, ec);
@@ -59,6 +63,7 @@ double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2])
             em[k] += bond * d[k];
     }
     double best = -INFINITY, dir[2] = {1.0, 0.0};
+    plane[0] = plane[1] = plane[2] = 0.0;
     for (int side = bond > 0.0 ? 1 : -1; side <= 1; side += 2) {
         double z = 0.5 * h * side;
         double e[3] = {em[0] + z * ec[0], em[1] + z * ec[1], em[2] + z * ec[2]};
@@ -72,6 +77,9 @@ double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2])
         }
         if (sigma[0] > best) {
             best = sigma[0];
+            plane[0] = stress[0];
+            plane[1] = stress[1];
+            plane[2] = stress[3];
             double l = hypot(dirs[0], dirs[1]);
             if (l > 0.0) {
                 dir[0] = dirs[0] / l;
@@ -83,32 +91,56 @@ double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2])
         m[0] = dir[0];
         m[1] = dir[1];
     }
-    return best / s->threshold[t];
+    return best;
+}
+
+/* fs_shell_face_ratio, and when stress is not NULL the plane stress it reads as a 3-D Voigt stress. */
+static double face_criterion(const fs_shell *s, int32_t t, double m[2], double stress[6])
+{
+    double plane[3], sigma1 = critical_stress(s, t, plane, m);
+    if (stress) {
+        /* sxx e1 e1^T + syy e2 e2^T + sxy (e1 e2^T + e2 e1^T), Voigt xx, yy, zz, xy, yz, zx */
+        const double *e1 = s->frame + 6 * (size_t)t, *e2 = e1 + 3;
+        static const int row[6] = {0, 1, 2, 0, 1, 2}, col[6] = {0, 1, 2, 1, 2, 0};
+        for (int k = 0; k < 6; k++) {
+            int i = row[k], j = col[k];
+            stress[k] = isfinite(sigma1) ? plane[0] * e1[i] * e1[j] + plane[1] * e2[i] * e2[j] +
+                                               plane[2] * (e1[i] * e2[j] + e2[i] * e1[j])
+                                         : 0.0;
+        }
+    }
+    return sigma1 / s->threshold[t];
+}
+
+double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2])
+{
+    return face_criterion(s, t, m, NULL);
 }
 
 typedef struct {
     const fs_shell *s;
-    double *ratio, *m;
+    double *ratio, *m, *stress;
 } ratios_ctx;
 
 static void ratios_range(void *ctx, int32_t t0, int32_t t1)
 {
     const ratios_ctx *c = ctx;
     for (int32_t t = t0; t < t1; t++)
-        c->ratio[t] = fs_shell_face_ratio(c->s, t, c->m ? c->m + 2 * (size_t)t : NULL);
+        c->ratio[t] = face_criterion(c->s, t, c->m ? c->m + 2 * (size_t)t : NULL,
+                                     c->stress ? c->stress + 6 * (size_t)t : NULL);
 }
 
-void fs_shell_face_ratios(fs_shell *s, double *ratio, double *m)
+void fs_shell_face_ratios(fs_shell *s, double *ratio, double *m, double *stress)
 {
     fs_shell_update_phi(s, s->x, false);
-    ratios_ctx c = {s, ratio, m};
+    ratios_ctx c = {s, ratio, m, stress};
     fs_shell_parallel(s->n_tris, ratios_range, &c);
 }
 
 double fs_shell_max_ratio(fs_shell *s, double *ratio)
 {
     double *r = ratio ? ratio : s->face_ratio, best = -INFINITY;
-    fs_shell_face_ratios(s, r, NULL);
+    fs_shell_face_ratios(s, r, NULL, NULL);
     for (int32_t t = 0; t < s->n_tris; t++)
         if (r[t] > best)
             best = r[t];

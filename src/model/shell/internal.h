@@ -309,9 +309,10 @@ void fs_shell_reserve(fs_shell *s, int32_t nodes, int32_t tris);
  * the unit principal direction in the face's frame (the crack's normal). NaN on failure. */
 double fs_shell_face_ratio(const fs_shell *s, int32_t t, double m[2]);
 
-/* Every face's ratio at the current state into ratio (n_tris), and its direction into m (2 per face,
- * may be NULL); updates phi first. */
-void fs_shell_face_ratios(fs_shell *s, double *ratio, double *m);
+/* Every face's ratio at the current state into ratio (n_tris), its direction into m (2 per face, may
+ * be NULL) and the plane stress the ratio reads, as a 3-D Voigt stress (tensor shears) in the
+ * model's frame, into stress (6 per face, zero where not finite; may be NULL); updates phi first. */
+void fs_shell_face_ratios(fs_shell *s, double *ratio, double *m, double *stress);
 
 /* The largest face ratio at the current state (updates phi); ratio (n_tris, may be NULL) gets each. */
 double fs_shell_max_ratio(fs_shell *s, double *ratio);

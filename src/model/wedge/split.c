@@ -361,6 +361,14 @@ typedef struct {
     int32_t n, cap;
 } ilist;
 
+static bool ilist_has(const ilist *l, int32_t x)
+{
+    for (int32_t k = 0; k < l->n; k++)
+        if (l->v[k] == x)
+            return true;
+    return false;
+}
+
 static void ilist_push(ilist *l, int32_t x)
 {
     FS_ARRAY_RESERVE(l->v, l->cap, l->n + 1, 16);
@@ -652,6 +660,71 @@ static int smooth_new_tips(fs_wedge_model *w, const int32_t ends[2], int n_rays)
     return fs_wedge_smooth(w, centres, n, radius, w->cfg.mesh.smooth_iterations, NULL);
 }
 
+/* The fracture plane normal m (3-D, unit) that steers tip node i, whose crack arrived along ahead:
+ * the principal plane of the stress averaged ahead of it (fs_tip_stress) over the top Gauss points
+ * of the living elements that the unbroken material connects to i within 3 radii. m is left as it is
+ * (the tip's most loaded element's plane) when the average pulls on no plane or direction_radius is
+ * 0. */
+static void tip_average_plane(fs_wedge_model *w, int32_t i, const double ahead[3], double m[3])
+{
+    if (!(w->cfg.fracture.direction_radius > 0.0))
+        return;
+    fs_mesh *mesh = w->mesh;
+    double radius = w->cfg.fracture.direction_radius * fs_wedge_tips_unit(w);
+    const double *tip = mesh->pos + 3 * (size_t)i;
+    ilist nodes = {0}, elems = {0};
+    ilist_push(&nodes, i);
+    for (int32_t q = 0; q < nodes.n; q++) {
+        int32_t v = nodes.v[q];
+        for (int32_t p = w->node_elem_start[v]; p < w->node_elem_start[v] + w->node_elem_count[v]; p++) {
+            int32_t e = w->node_elem[p];
+            if (w->state[e] != FS_WEDGE_ALIVE || ilist_has(&elems, e))
+                continue;
+            ilist_push(&elems, e);
+            for (int c = 0; c < 3; c++) {
+                int32_t j = mesh->tri[3 * (size_t)e + c];
+                double d[3];
+                fs_domain_delta(&mesh->domain, tip, mesh->pos + 3 * (size_t)j, d);
+                if (fs_norm3(d) <= 3.0 * radius && !ilist_has(&nodes, j))
+                    ilist_push(&nodes, j);
+            }
+        }
+    }
+    const stresses st = {w->stress_top, NULL, 0.0};
+    fs_tip_stress avg;
+    fs_tip_stress_begin(&avg, ahead, w->normal + 3 * (size_t)i, radius);
+    for (int32_t q = 0; q < elems.n; q++) {
+        int32_t e = elems.v[q];
+        double rel[3][3];
+        for (int c = 0; c < 3; c++)
+            fs_domain_delta(&mesh->domain, tip, mesh->pos + 3 * (size_t)mesh->tri[3 * (size_t)e + c], rel[c]);
+        double ab[3], ac[3], n[3];
+        fs_sub3(ab, rel[1], rel[0]);
+        fs_sub3(ac, rel[2], rel[0]);
+        fs_cross3(n, ab, ac);
+        double third = fs_norm3(n) / 6.0;
+        for (int c = 0; c < 3; c++) {
+            /* top Gauss point c sits at (2/3, 1/6, 1/6) of the triangle from corner c */
+            double at[3], s[6];
+            for (int k = 0; k < 3; k++)
+                at[k] = (4.0 * rel[c][k] + rel[(c + 1) % 3][k] + rel[(c + 2) % 3][k]) / 6.0;
+            stress_at(&st, e, c, s);
+            fs_tip_stress_add(&avg, at, w->normal + 3 * (size_t)mesh->tri[3 * (size_t)e + c], third, s);
+        }
+    }
+    free(nodes.v);
+    free(elems.v);
+    double mean[6], sigma1, plane[3];
+    if (!fs_tip_stress_mean(&avg, mean))
+        return;
+    if (fs_nodal_principal_plane(mean, &sigma1, plane) < 0) {
+        fs_error_clear();
+        return;
+    }
+    if (sigma1 > 0.0)
+        memcpy(m, plane, sizeof plane);
+}
+
 /* The in-plane crack direction at node n from the fracture plane normal m (3-D). */
 static bool crack_direction(const fs_wedge_model *w, int32_t n, const double m[3], double dir[3])
 {
@@ -776,9 +849,10 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed)
 
     double dir[3], rays[2][3];
     if (!have_m) {
-        if (from_tip)
+        if (from_tip) {
             tip_ratio(w, pick, m);
-        else
+            tip_average_plane(w, pick, w->tip_dir + 3 * (size_t)tip_find(w, pick), m);
+        } else
             node_ratio(w, pick, m);
     }
     if (!crack_direction(w, pick, m, dir)) {
