@@ -38,4 +38,6 @@ bark-black-hickory 256x256 mesh.elements=4000
 mud-thick 256x256
 bark-tet 256x163
 glaze-tet 256x128 mesh.elements=3000
+eggshell 256x128
+bark-shell 197x256 mesh.elements=2000
 LIST

@@ -1,11 +1,13 @@
 /* Test helper: measures a crack mask or a crack graph, for the shell tests of the crack presets (orientation, density inside a map). */
 #include <math.h>
 #include <stdbool.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/error.h"
+#include "base/uf.h"
 #include "base/vec.h"
 #include "image/image.h"
 #include "io/json.h"
@@ -18,6 +20,7 @@ static int usage(void)
     fprintf(stderr, "usage: crack_stats runs MASK.png [V0 V1 [U0 U1]]\n"
                     "       crack_stats inside MASK.png GREY.png LEVEL\n"
                     "       crack_stats crossings CELLID.png U0 U1\n"
+                    "       crack_stats pieces MASK.png CELLID.png none|x|y|xy\n"
                     "       crack_stats directions CRACKS.json SPAN_U SPAN_V MIN_CHORD DEGREES\n");
     return 2;
 }
@@ -215,6 +218,96 @@ static int directions(int argc, char **argv)
     return 0;
 }
 
+static int compare_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+/* Whether the fragments stand apart in the crack mask: the 4-connected pieces of the pixels under
+ * half intensity (the mask's solid ground; wrapping across the periodic axes given), against the
+ * fragments in the cell-id map (its distinct non-zero ids, the model's fragments that show). Prints
+ * "PIECES FRAGMENTS JOINED COVERAGE": JOINED counts the pieces that hold pixels of more than one
+ * fragment (a crack too narrow to separate them at half intensity), COVERAGE is the mean mask
+ * value. A piece may hold part of a fragment only (an open crack that nearly cuts it through). */
+static int pieces(int argc, char **argv)
+{
+    if (argc != 5 || (strcmp(argv[4], "none") && strcmp(argv[4], "x") && strcmp(argv[4], "y") &&
+                      strcmp(argv[4], "xy")))
+        return usage();
+    int w, h, cw, ch;
+    float *m = read_grey(argv[2], &w, &h);
+    if (!m)
+        return 2;
+    float *c = read_grey(argv[3], &cw, &ch);
+    if (!c || cw != w || ch != h) {
+        if (c)
+            fprintf(stderr, "crack_stats: %s is %dx%d, %s %dx%d\n", argv[3], cw, ch, argv[2], w, h);
+        free(m);
+        free(c);
+        return 2;
+    }
+    bool wrap_x = strchr(argv[4], 'x') != NULL, wrap_y = strchr(argv[4], 'y') != NULL;
+    int32_t n = (int32_t)w * h;
+    int32_t *parent = malloc((size_t)n * sizeof *parent);
+    float *ids = malloc((size_t)n * sizeof *ids);
+    if (!parent || !ids) {
+        fprintf(stderr, "crack_stats: out of memory\n");
+        return 2;
+    }
+    fs_uf_init(parent, n);
+    double coverage = 0.0;
+    int32_t n_ids = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            int32_t i = (int32_t)y * w + x;
+            coverage += m[i];
+            if (c[i] > 0.0f)
+                ids[n_ids++] = c[i];
+            if (m[i] >= CRACK)
+                continue;
+            int32_t right = x + 1 < w ? i + 1 : wrap_x ? i + 1 - w : -1;
+            int32_t down = y + 1 < h ? i + w : wrap_y ? x : -1;
+            if (right >= 0 && m[right] < CRACK)
+                fs_uf_union(parent, i, right);
+            if (down >= 0 && m[down] < CRACK)
+                fs_uf_union(parent, i, down);
+        }
+    long count = 0, joined = 0;
+    float *first = calloc((size_t)n, sizeof *first); /* per root: the first fragment id seen in it */
+    uint8_t *mixed = calloc((size_t)n, 1);
+    if (!first || !mixed) {
+        fprintf(stderr, "crack_stats: out of memory\n");
+        return 2;
+    }
+    for (int32_t i = 0; i < n; i++) {
+        if (m[i] >= CRACK)
+            continue;
+        int32_t r = fs_uf_find(parent, i);
+        count += r == i;
+        if (c[i] > 0.0f) {
+            if (first[r] == 0.0f)
+                first[r] = c[i];
+            else if (first[r] != c[i] && !mixed[r]) {
+                mixed[r] = 1;
+                joined++;
+            }
+        }
+    }
+    free(first);
+    free(mixed);
+    qsort(ids, (size_t)n_ids, sizeof *ids, compare_float);
+    long fragments = 0;
+    for (int32_t k = 0; k < n_ids; k++)
+        fragments += k == 0 || ids[k] != ids[k - 1];
+    printf("%ld %ld %ld %.5f\n", count, fragments, joined, coverage / n);
+    free(parent);
+    free(ids);
+    free(m);
+    free(c);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2)
@@ -227,5 +320,7 @@ int main(int argc, char **argv)
         return inside(argc, argv);
     if (!strcmp(argv[1], "crossings"))
         return crossings(argc, argv);
+    if (!strcmp(argv[1], "pieces"))
+        return pieces(argc, argv);
     return usage();
 }

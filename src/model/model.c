@@ -23,6 +23,7 @@ fs_model_setup fs_model_setup_default(void)
     memset(&s, 0, sizeof s);
     s.kind = FS_MODEL_VORONOI;
     s.seed = 1;
+    s.opening_scale = 1.0;
     s.mesh = fs_mesh_params_default();
     s.material = fs_material_default();
     s.growth = fs_growth_default();

@@ -86,6 +86,9 @@ struct fs_model_setup {
     fs_wedge_params wedge;
     fs_tet_params tet;
     fs_shell_params shell;
+    double opening_scale;         /* [render] opening_scale: the surface (fs_model_surface) draws the
+                                     in-plane displacement this many times over, so each crack opens
+                                     as wide, along its length, as its simulated opening times it */
     const double *corner_uv;      /* mesh domain: 6 per triangle of the mesh given to fs_model_init, the
                                      texture coordinates of its corners (the UV layout the maps are
                                      rendered into; borrowed); NULL on the other domains */

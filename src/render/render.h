@@ -22,6 +22,9 @@ typedef struct {
     float color_background[3];  /* exposed background at the bottom of cracks */
     double color_variation;     /* per-cell variation of the material colour, [0, 1] */
     double roughness;           /* PBR roughness of the surface, [0, 1], for the packed engine maps */
+    double opening_scale;       /* the cracks are drawn this many times as open as simulated (the
+                                   models' in-plane displacement scaled); read by the model through
+                                   fs_model_setup.opening_scale */
 } fs_render_params;
 
 /* 1024 x 1024, supersample 4, 1024 x 768 preview, height scale 1, OpenGL normals, a warm clay palette. */

@@ -45,5 +45,6 @@ fs_model_setup fs_config_model_setup(const fs_config *cfg)
     s.wedge = cfg->wedge;
     s.tet = cfg->tet;
     s.shell = cfg->shell;
+    s.opening_scale = cfg->render.opening_scale;
     return s;
 }

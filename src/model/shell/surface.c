@@ -85,10 +85,11 @@ static void emit(render_ctx *r, const double *uv, const double *p, const attr a[
     fs_surface_add_tri(r->out, v[0], v[1], v[2]);
 }
 
-/* The displacement of node i relative to the surface it is bonded to, times the gap scale. */
+/* The displacement of node i relative to the surface it is bonded to, times the gap scale and the
+ * opening scale. */
 static void opening(const fs_shell *s, int32_t i, double d[3])
 {
-    double g = s->cfg.shell.gap_scale;
+    double g = s->cfg.shell.gap_scale * s->cfg.opening_scale;
     for (int k = 0; k < 3; k++)
         d[k] = g * (s->x[3 * (size_t)i + k] - s->anchor[3 * (size_t)i + k]);
 }

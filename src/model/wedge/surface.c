@@ -75,13 +75,14 @@ static double top_height(const fs_wedge_model *w, int32_t node)
     return w->assembled_thickness * w->thickness_factor[node] + rise;
 }
 
-/* In-plane displacement of a node's top (cm, model frame): what opens the cracks of the split method. */
+/* In-plane displacement of a node's top (cm, model frame) times [render] opening_scale, added to p: what
+ * opens the cracks of the split method. */
 static void top_shift(const fs_wedge_model *w, int32_t node, double *p)
 {
     const double *u = w->u + 6 * (size_t)node + 3, *n = w->normal + 3 * (size_t)node;
-    double un = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
+    double un = n[0] * u[0] + n[1] * u[1] + n[2] * u[2], scale = w->cfg.opening_scale;
     for (int k = 0; k < 3; k++)
-        p[k] += u[k] - un * n[k];
+        p[k] += scale * (u[k] - un * n[k]);
 }
 
 /* ---- emitting ---- */

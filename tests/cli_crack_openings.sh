@@ -1,0 +1,66 @@
+# Cracks drawn open ([render] opening_scale): a crack's width in the maps follows its simulated
+# opening times the scale, and at the mud presets' default every fragment stands apart in the crack
+# mask. tests/crack_stats pieces counts the 4-connected pieces of the mask under half intensity
+# (wrapping on the periodic tile) and the fragments of the cell-id map.
+. "$top_srcdir/tests/lib.sh"
+STATS="$(dirname "$FISSURE")/tests/crack_stats"
+
+# run NAME OPTIONS...: renders the crack mask and cell ids into $tmp/NAME; sets pieces, frags, joined
+# (pieces holding more than one fragment) and cover (empty when something fails).
+run() {
+    name=$1
+    shift
+    pieces='' frags='' joined='' cover=''
+    if ! "$FISSURE" -q -o "$tmp/$name" -n c --maps crackmask,cellid "$@" >/dev/null 2>"$tmp/stderr"; then
+        not_ok "$name: fissure runs"; sed 's/^/    /' "$tmp/stderr" | head -5; return
+    fi
+    set -- $("$STATS" pieces "$tmp/$name/c_crackmask.png" "$tmp/$name/c_cellid.png" xy)
+    pieces=${1:-} frags=${2:-} joined=${3:-} cover=${4:-}
+}
+# apart WHAT: no piece of the last run's mask joins two fragments, and (an open crack may cut a
+# fragment nearly through) there are at least as many pieces as fragments.
+apart() {
+    if [ "${joined:-1}" -eq 0 ] && [ "${pieces:-0}" -ge "${frags:-1}" ]; then
+        ok "$1: $frags fragments apart in $pieces pieces of the mask"
+    else not_ok "$1: '$joined' pieces of the mask join fragments ('$frags' fragments, '$pieces' pieces)"; fi
+}
+# covers WHAT LO HI: the last run's mean mask value is within [LO, HI].
+covers() {
+    if [ -n "$cover" ] && awk_true "$cover >= $2 && $cover <= $3"; then ok "$1: cracks cover $cover of the tile"
+    else not_ok "$1: cracks cover '$cover' of the tile, expected $2 to $3"; fi
+}
+
+# mud at its default (opening_scale 4), seed 11: open gaps over 5-15 % of the tile, every fragment
+# apart, at 1024 x 1024 and at 4096 x 4096, and with the layer half as thick (smaller cells).
+run mud --seed 11 "$PRESETS/mud.ini"
+covers "mud, seed 11" 0.05 0.15
+apart "mud, seed 11"
+mud_cover=$cover
+run mud-4k --seed 11 --size 4096x4096 "$PRESETS/mud.ini"
+covers "mud, seed 11, 4096 x 4096" 0.05 0.15
+apart "mud, seed 11, 4096 x 4096"
+run mud-thin --seed 11 --set material.thickness=0.2 "$PRESETS/mud.ini"
+covers "mud, seed 11, thickness 0.2" 0.05 0.15
+apart "mud, seed 11, thickness 0.2"
+
+# The width follows the scale: the same simulation drawn at 1 and 2 covers a quarter and a half of
+# what it covers at 4 (within 20 %); at 1, the hairlines no longer keep every fragment apart.
+run mud-1 --seed 11 --set render.opening_scale=1 "$PRESETS/mud.ini"
+cover1=$cover joined1=$joined
+run mud-2 --seed 11 --set render.opening_scale=2 "$PRESETS/mud.ini"
+cover2=$cover
+if [ -n "$cover1" ] && [ -n "$cover2" ] && [ -n "$mud_cover" ] &&
+    awk_true "$cover1 < $cover2 && $cover2 < $mud_cover && $cover1 * 4 / $mud_cover > 0.8 && $cover1 * 4 / $mud_cover < 1.2 && $cover2 * 2 / $mud_cover > 0.8 && $cover2 * 2 / $mud_cover < 1.2"
+then ok "crack cover grows with opening_scale: $cover1 at 1, $cover2 at 2, $mud_cover at 4"
+else not_ok "crack cover at opening_scale 1, 2, 4: '$cover1' '$cover2' '$mud_cover', expected in proportion"; fi
+if [ "${joined1:-0}" -gt 0 ]; then ok "at opening_scale 1 hairlines join fragments ($joined1 pieces hold two or more)"
+else not_ok "at opening_scale 1: '$joined1' pieces join fragments: the measure sees no joined fragment"; fi
+
+# The shell model draws its openings to the same scale ([shell] gap_scale times opening_scale).
+run egg-1 --size 512x256 "$PRESETS/eggshell.ini"
+egg1=$cover
+run egg-2 --size 512x256 --set render.opening_scale=2 "$PRESETS/eggshell.ini"
+if [ -n "$egg1" ] && [ -n "$cover" ] && awk_true "$cover > 1.5 * $egg1"; then
+    ok "eggshell: cracks cover $egg1 at opening_scale 1, $cover at 2"
+else not_ok "eggshell: cracks cover '$egg1' at opening_scale 1, '$cover' at 2, expected at least 1.5 times"; fi
+finish
