@@ -565,8 +565,8 @@ typedef struct {
     int32_t n;
 } face_stresses;
 
-/* The unit normal of face t in the rest shape, by its corners' order, into normal; returns its area. */
-static double face_normal(const fs_shell *s, int32_t t, double normal[3])
+/* The unit normal of face t in the rest shape, by its corners' order, into normal. */
+static void face_normal(const fs_shell *s, int32_t t, double normal[3])
 {
     double p[3][3], ab[3], ac[3];
     for (int k = 0; k < 3; k++)
@@ -577,7 +577,6 @@ static double face_normal(const fs_shell *s, int32_t t, double normal[3])
     double twice = fs_norm3(normal);
     for (int j = 0; j < 3 && twice > 0.0; j++)
         normal[j] /= twice;
-    return 0.5 * twice;
 }
 
 static int32_t find_in(const int32_t *list, int32_t n, int32_t x)
@@ -591,7 +590,7 @@ static int32_t find_in(const int32_t *list, int32_t n, int32_t x)
 /* The fracture plane normal m (3-D, unit) that steers the crack of tip v: the principal plane of the
  * stress averaged ahead of v (fs_tip_stress, the crack arrived along tip_dir[v]) over the faces the
  * material connects to v within 3 radii of it (in the rest shape), each at its centroid with its
- * rest area. False when [fracture] direction_radius is 0 or the average pulls on no plane: then the
+ * rest area (area0). False when [fracture] direction_radius is 0 or the average pulls on no plane: then the
  * face's own direction stands. */
 static bool tip_average_plane(const fs_shell *s, face_cut *fc, const face_stresses *fs, int32_t v, const double normal[3],
                               double m[3])
@@ -637,8 +636,8 @@ static bool tip_average_plane(const fs_shell *s, face_cut *fc, const face_stress
                 }
             }
             double normal_t[3];
-            double area = face_normal(s, t, normal_t);
-            fs_tip_stress_add(&avg, centroid, normal_t, area, fs->stress + 6 * (size_t)t);
+            face_normal(s, t, normal_t);
+            fs_tip_stress_add(&avg, centroid, normal_t, s->area0[t], fs->stress + 6 * (size_t)t);
         }
     }
     free(nodes);
