@@ -136,6 +136,7 @@ static const key_def key_table[] = {
     {"render", "preview_size", KEY_SIZE, OFF(render.preview_width), 16, 16384, GE | LE, NULL, NULL},
     {"render", "height_scale", KEY_REAL, OFF(render.height_scale), 0, 0, GT, NULL, NULL},
     {"render", "opening_scale", KEY_REAL, OFF(render.opening_scale), 0, 50, GT | LE, NULL, NULL},
+    {"render", "wall_slope", KEY_REAL, OFF(render.wall_slope), 0, 1, GE | LE, NULL, NULL},
     {"render", "supersample", KEY_INT, OFF(render.supersample), 1, 8, GE | LE, NULL, NULL},
     {"render", "normal", KEY_WORD, OFF(render.normal), 0, 0, 0, normal_words, NULL},
     {"render", "color_material", KEY_COLOR, OFF(render.color_material), 0, 0, 0, NULL, NULL},

@@ -89,6 +89,8 @@ struct fs_model_setup {
     double opening_scale;         /* [render] opening_scale: the surface (fs_model_surface) draws the
                                      in-plane displacement this many times over, so each crack opens
                                      as wide, along its length, as its simulated opening times it */
+    double wall_slope;            /* [render] wall_slope: the share of a crack's width, in [0, 1], over
+                                     which the surface draws its walls sloping down to its floor */
     const double *corner_uv;      /* mesh domain: 6 per triangle of the mesh given to fs_model_init, the
                                      texture coordinates of its corners (the UV layout the maps are
                                      rendered into; borrowed); NULL on the other domains */

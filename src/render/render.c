@@ -19,6 +19,7 @@ fs_render_params fs_render_params_default(void)
         .preview_height = 768,
         .height_scale = 1.0,
         .opening_scale = 1.0,
+        .wall_slope = 0.0,
         .normal = FS_NORMAL_OPENGL,
         .color_material = {0.630757153f, 0.423267663f, 0.262250662f},    /* sRGB #d0ae8c decoded */
         .color_crack = {0.0886555836f, 0.0423114114f, 0.0231533665f},   /* sRGB #543a2a */

@@ -25,6 +25,9 @@ typedef struct {
     double opening_scale;       /* the cracks are drawn this many times as open as simulated (the
                                    models' in-plane displacement scaled); read by the model through
                                    fs_model_setup.opening_scale */
+    double wall_slope;          /* [0, 1]: the share of each crack's width over which its walls slope
+                                   down to its floor (0: upright walls); read by the model through
+                                   fs_model_setup.wall_slope */
 } fs_render_params;
 
 /* 1024 x 1024, supersample 4, 1024 x 768 preview, height scale 1, OpenGL normals, a warm clay palette. */

@@ -46,5 +46,6 @@ fs_model_setup fs_config_model_setup(const fs_config *cfg)
     s.tet = cfg->tet;
     s.shell = cfg->shell;
     s.opening_scale = cfg->render.opening_scale;
+    s.wall_slope = cfg->render.wall_slope;
     return s;
 }

@@ -16,6 +16,9 @@
  * before the chord is halved (geom/sphere_surface.h). */
 #define SPHERE_UV_TOLERANCE 5e-4
 
+/* Most points of a polygon of floor where cracks meet (before the feet of sloping walls). */
+#define JUNCTION_CAP 64
+
 int32_t fs_wedge_fragments(const fs_wedge_model *w, int32_t *labels)
 {
     int32_t n = w->n_elems;
@@ -100,6 +103,10 @@ typedef struct {
     double *delta;   /* split: 3 per point id (wall_point.id): where it is drawn, less its displaced
                       * position; nonzero only where walls cross (close_crossings) */
     int32_t *parent; /* split: union-find over point ids joining copies where walls cross, or NULL */
+    double foot;     /* split: where a sloping wall meets the floor, as a share of the floor's width
+                      * from the wall (half of [render] wall_slope); 0: upright walls */
+    int32_t feet;    /* split: feet drawn so far (they are points of the surface of their own) */
+    bool fan_ears;   /* split: clip_ears draws each ear as a fan from a point of floor at its centroid */
 } render_ctx;
 
 /* fs_sphere_refiner.vertex: a vertex with the attributes of the triangle's corners mixed by w. */
@@ -207,17 +214,94 @@ static double area2(const render_ctx *r, const double *a, const double *b, const
     return len > 0.0 ? fs_dot3(n, s) / len : 0.0;
 }
 
-/* A floor triangle over three top points, unless two of them are one point of the surface. */
-static void emit_floor(render_ctx *r, const wall_point *a, const wall_point *b, const wall_point *c)
+/* A triangle over three points where they are drawn, with their attributes, unless two of them are
+ * one point of the surface. */
+static void emit_points(render_ctx *r, const wall_point *a, const wall_point *b, const wall_point *c)
 {
     if (a->vertex == b->vertex || b->vertex == c->vertex || c->vertex == a->vertex)
         return;
+    const wall_point *v[3] = {a, b, c};
     double p[3][3];
-    memcpy(p[0], a->top, sizeof p[0]);
-    memcpy(p[1], b->top, sizeof p[1]);
-    memcpy(p[2], c->top, sizeof p[2]);
-    attr f[3] = {floor_attr, floor_attr, floor_attr};
-    emit_tri(r, (const double(*)[3])p, f);
+    attr at[3];
+    for (int k = 0; k < 3; k++) {
+        memcpy(p[k], v[k]->top, sizeof p[k]);
+        at[k] = v[k]->a;
+    }
+    emit_tri(r, (const double(*)[3])p, at);
+}
+
+/* design: [render] wall_slope s draws each wall of a crack sloping from the top of its fragment down
+ * to the floor over the share s / 2 of the gap next to it, so a crack's section is a trapezoid, a V
+ * at s = 1. Every edge of the floor across a crack (from a copy a of a rest point to another copy
+ * b) gets two points where the walls meet the floor, its feet, a + (s / 2)(b - a) and
+ * b + (s / 2)(a - b); the floor quads of the pairs (split_render_mesh) and the polygons where cracks
+ * meet (emit_junction) put the same feet on their common edges, so they meet vertex to vertex. The
+ * slope between a wall's top edge and its feet has the wall's attributes: crack coverage 1 and the
+ * height of the top at its upper edge. */
+
+/* The foot of the slope on the floor's edge from a across to b: the point near a. */
+static wall_point foot_point(render_ctx *r, const wall_point *a, const wall_point *b)
+{
+    wall_point f = *a;
+    for (int k = 0; k < 3; k++)
+        f.top[k] = a->top[k] + r->foot * (b->top[k] - a->top[k]);
+    f.vertex = -2 - r->feet++;
+    f.a = floor_attr;
+    return f;
+}
+
+/* A wall's top edge point as the upper edge of its slope: the top's height, the crack's cover. */
+static wall_point slope_top(const wall_point *p)
+{
+    wall_point s = *p;
+    s.a = (attr){p->a.height, 1.0, 0.0, 0.0};
+    return s;
+}
+
+/* A quad (a, b, c, d) counter-clockwise, split along the diagonal that keeps both triangles the
+ * larger; corners that are one point of the surface make it a triangle or nothing. */
+static void emit_quad(render_ctx *r, const wall_point *a, const wall_point *b, const wall_point *c,
+                      const wall_point *d)
+{
+    const wall_point *q[4] = {a, b, c, d};
+    bool diag_bd = b->vertex != c->vertex && a->vertex != d->vertex
+                   && fmin(area2(r, a->top, b->top, c->top), area2(r, a->top, c->top, d->top))
+                          < fmin(area2(r, a->top, b->top, d->top), area2(r, b->top, c->top, d->top));
+    static const int tris[2][2][3] = {{{0, 1, 2}, {0, 2, 3}}, {{0, 1, 3}, {1, 2, 3}}};
+    for (int t = 0; t < 2; t++) {
+        const int *ix = tris[diag_bd][t];
+        emit_points(r, q[ix[0]], q[ix[1]], q[ix[2]]);
+    }
+}
+
+/* The floor of the pair quad (q, p, q2, p2) between the walls p -> q and p2 -> q2: one quad with
+ * upright walls, else a slope down from each wall and the floor between their feet. */
+static void emit_gap(render_ctx *r, const wall_point quad[4])
+{
+    if (r->foot <= 0.0) {
+        wall_point f[4];
+        for (int c = 0; c < 4; c++) {
+            f[c] = quad[c];
+            f[c].a = floor_attr;
+        }
+        emit_quad(r, f + 0, f + 1, f + 2, f + 3);
+        return;
+    }
+    const wall_point *q = quad + 0, *p = quad + 1, *q2 = quad + 2, *p2 = quad + 3;
+    wall_point tq = slope_top(q), tp = slope_top(p), tq2 = slope_top(q2), tp2 = slope_top(p2);
+    wall_point fp = foot_point(r, p, q2), fq2 = foot_point(r, q2, p), fp2 = foot_point(r, p2, q),
+               fq = foot_point(r, q, p2);
+    if (p->vertex == q2->vertex) /* a crack tip: both feet are the tip */
+        fp = fq2 = tp;
+    if (q->vertex == p2->vertex)
+        fq = fp2 = tq;
+    if (r->foot >= 0.5) { /* a V: the feet meet in the middle */
+        fq2 = fp;
+        fp2 = fq;
+    }
+    emit_quad(r, &tq, &tp, &fp, &fq);
+    emit_quad(r, &fq, &fp, &fq2, &fp2);
+    emit_quad(r, &fq2, &tq2, &tp2, &fp2);
 }
 
 /* ---- rest points: nodes at one rest position (a node and its duplicates) ---- */
@@ -695,13 +779,44 @@ static void apply_joins(render_ctx *r, wall_point *pts, int32_t n_pts, int32_t n
     free(rep);
 }
 
+/* An ear (points i, j, k) that clip_ears cuts from polygon p (m points): a triangle. With
+ * render_ctx.fan_ears, a side of it that is a diagonal of the polygon between two points above the
+ * floor (two corners on walls' top edges, which would bridge the crack at their height) is cut at
+ * its midpoint, a point of floor (computed from its end with the smaller index, so the ear on the
+ * other side cuts it at the same point), and the ear is fanned from the first such point. */
+static void emit_ear(render_ctx *r, const wall_point *p, int32_t m, int32_t i, int32_t j, int32_t k)
+{
+    int32_t ix[3] = {i, j, k};
+    wall_point ring[6];
+    int n = 0, first_mid = -1;
+    for (int s = 0; s < 3; s++) {
+        int32_t a = ix[s], b = ix[(s + 1) % 3];
+        ring[n++] = p[a];
+        if (!r->fan_ears || (a + 1) % m == b || (b + 1) % m == a || !(p[a].a.height > 0.0 && p[b].a.height > 0.0))
+            continue;
+        const wall_point *lo = p + (a < b ? a : b), *hi = p + (a < b ? b : a);
+        ring[n] = *lo;
+        for (int q = 0; q < 3; q++)
+            ring[n].top[q] = 0.5 * (lo->top[q] + hi->top[q]);
+        ring[n].vertex = -2 - r->feet++;
+        ring[n].a = floor_attr;
+        if (first_mid < 0)
+            first_mid = n;
+        n++;
+    }
+    if (first_mid < 0)
+        first_mid = 0;
+    for (int s = 1; s + 1 < n; s++)
+        emit_points(r, ring + first_mid, ring + (first_mid + s) % n, ring + (first_mid + s + 1) % n);
+}
+
 /* Triangulates a small counter-clockwise polygon by clipping ears, emitting the triangles if emit.
  * Returns whether every triangle was an ear of positive area; when not, and emit is set, what is
  * left is fanned. */
 static bool clip_ears(render_ctx *r, const wall_point *p, int32_t m, bool emit)
 {
-    int32_t idx[64], n = 0;
-    for (int32_t k = 0; k < m && n < 64; k++)
+    int32_t idx[3 * JUNCTION_CAP], n = 0;
+    for (int32_t k = 0; k < m && n < 3 * JUNCTION_CAP; k++)
         idx[n++] = k;
     while (n > 3) {
         int32_t ear = -1;
@@ -722,38 +837,42 @@ static bool clip_ears(render_ctx *r, const wall_point *p, int32_t m, bool emit)
         if (ear < 0)
             break;
         if (emit)
-            emit_floor(r, p + idx[(ear + n - 1) % n], p + idx[ear], p + idx[(ear + 1) % n]);
+            emit_ear(r, p, m, idx[(ear + n - 1) % n], idx[ear], idx[(ear + 1) % n]);
         for (int32_t j = ear; j + 1 < n; j++)
             idx[j] = idx[j + 1];
         n--;
     }
     bool ok = n == 3 && area2(r, p[idx[0]].top, p[idx[1]].top, p[idx[2]].top) > 0.0;
     for (int32_t k = 1; emit && k + 1 < n; k++)
-        emit_floor(r, p + idx[0], p + idx[k], p + idx[k + 1]);
+        emit_ear(r, p, m, idx[0], idx[k], idx[k + 1]);
     return ok;
 }
 
 /* The hole of junction loop c (m points, its sides' cross edges in edge) merged with the quads of
  * floor on its sides that are not yet consumed: each side c_k -> c_k+1 is replaced by the two far
  * points of its quad (one where the far end is a crack tip). Writes at most cap points to poly,
- * in the frame of c, and returns the count (0 if they do not fit). */
+ * in the frame of c, with cross[j] telling whether the side from point j to the next crosses a
+ * crack (else it runs along a wall), and returns the count (0 if they do not fit). */
 static int32_t junction_polygon(const render_ctx *r, const wall_point *pts, const int32_t *pair, const cross_edge *x,
                                 const wall_point *c, const int32_t *edge, int32_t m, const uint8_t *consumed,
-                                wall_point *poly, int32_t cap)
+                                wall_point *poly, uint8_t *cross, int32_t cap)
 {
     int32_t n = 0;
     for (int32_t k = 0; k < m; k++) {
         if (n == cap)
             return 0;
+        cross[n] = 1;
         poly[n++] = c[k];
         const cross_edge *e = x + edge[k];
         if (consumed[e->pair])
             continue;
+        cross[n - 1] = 0;
         wall_point quad[4]; /* q, p, q2, p2 */
         pair_quad(r, pts, pair + 2 * e->pair, quad);
         /* the side runs from the cross edge's end to its start: q2 -> (p2, q) -> p, or
          * q -> (p, q2) -> p2 */
         wall_point far[2] = {e->end ? quad[1] : quad[3], e->end ? quad[2] : quad[0]};
+        int32_t added[2] = {-1, -1};
         for (int f = 0; f < 2; f++) {
             align_point(r, far + f, c[k].rest);
             const wall_point *next = c + (k + 1) % m;
@@ -761,10 +880,94 @@ static int32_t junction_polygon(const render_ctx *r, const wall_point *pts, cons
                 continue;
             if (n == cap)
                 return 0;
+            cross[n] = 0;
+            added[f] = n;
             poly[n++] = far[f];
         }
+        if (added[0] >= 0 && added[1] >= 0) /* far[0] -> far[1]: the quad's other edge across its crack */
+            cross[added[0]] = 1;
     }
     return n;
+}
+
+/* The polygon p (n points, the feet marked in foot) cut into the floor between its feet and, for
+ * each run of corners between two feet, a sloping piece (foot, corners, foot): the slopes meet in
+ * mitres. A run whose piece would turn over (a corner carried past the line between its feet)
+ * joins the floor's polygon instead, which then rises to that corner. Drawn if emit; returns
+ * whether every piece is a simple polygon (cut into ears of positive area) and there are three
+ * feet or more. */
+static bool mitred(render_ctx *r, const wall_point *p, const bool *foot, int32_t n, bool emit)
+{
+    wall_point inner[3 * JUNCTION_CAP], run[3 * JUNCTION_CAP];
+    int32_t n_inner = 0, n_feet = 0, first = -1;
+    for (int32_t k = 0; k < n; k++)
+        if (foot[k]) {
+            n_feet++;
+            if (first < 0)
+                first = k;
+        }
+    if (n_feet < 3)
+        return false;
+    for (int32_t i = first, done = 0; done < n_feet; done++) {
+        int32_t j = (i + 1) % n, len = 1;
+        run[0] = p[i];
+        while (!foot[j]) {
+            run[len++] = p[j];
+            j = (j + 1) % n;
+        }
+        run[len++] = p[j];
+        inner[n_inner++] = p[i];
+        if (len > 2 && !clip_ears(r, run, len, false))
+            for (int32_t k = 1; k + 1 < len; k++)
+                inner[n_inner++] = run[k];
+        else if (len > 2 && emit)
+            clip_ears(r, run, len, true);
+        i = j;
+    }
+    if (!clip_ears(r, inner, n_inner, false))
+        return false;
+    if (emit)
+        clip_ears(r, inner, n_inner, true);
+    return true;
+}
+
+/* A polygon of floor where cracks meet (c, m points counter-clockwise; cross as junction_polygon
+ * gives it, or NULL when every side crosses a crack): with upright walls a flat floor. With sloping
+ * walls the feet of the slopes go on its sides across cracks, so that it meets the quads' slopes
+ * edge to edge, and its corners lie on the walls' top edges: mitred (the slopes from each run of
+ * corners down to the feet beside it, the floor between the feet), or, where that does not make
+ * simple pieces (a polygon merged with the quads of a crack, wrapped around a corner carried into
+ * the gap), cut into ears whose diagonals between two corners dip to the floor at their midpoints,
+ * so that no ear bridges the gap at the tops' height. */
+static void emit_junction(render_ctx *r, const wall_point *c, const uint8_t *cross, int32_t m)
+{
+    wall_point poly[3 * JUNCTION_CAP];
+    bool is_foot[3 * JUNCTION_CAP];
+    int32_t n = 0;
+    for (int32_t k = 0; k < m && k < JUNCTION_CAP; k++) {
+        const wall_point *next = c + (k + 1) % m;
+        poly[n] = r->foot > 0.0 ? slope_top(c + k) : c[k];
+        if (r->foot <= 0.0)
+            poly[n].a = floor_attr;
+        is_foot[n++] = false;
+        if (r->foot <= 0.0 || (cross && !cross[k]) || next->vertex == c[k].vertex)
+            continue;
+        for (int f = 0; f < (r->foot < 0.5 ? 2 : 1); f++) {
+            is_foot[n] = true;
+            poly[n++] = f ? foot_point(r, next, c + k) : foot_point(r, c + k, next);
+        }
+    }
+    if (r->foot <= 0.0) {
+        clip_ears(r, poly, n, true);
+        return;
+    }
+    if (mitred(r, poly, is_foot, n, false)) {
+        mitred(r, poly, is_foot, n, true);
+        return;
+    }
+    r->fan_ears = true;
+    clip_ears(r, poly, n, true);
+    r->fan_ears = false;
 }
 
 /* design: the model has no contact, so where a crack is pressed shut its two walls can pass each
@@ -810,7 +1013,8 @@ static int32_t close_crossings(render_ctx *r, wall_point *pts, int32_t n_pts, co
 
     cross_edge *x = fs_malloc((2 * (size_t)n_pairs + 1) * sizeof *x);
     int32_t n_x = cross_edges(r, pts, pair, n_pairs, x);
-    wall_point *loop, poly[64];
+    wall_point *loop, poly[JUNCTION_CAP];
+    uint8_t cross[JUNCTION_CAP];
     int32_t *edge, *start;
     int32_t n_loops = junction_loops(r, x, n_x, &loop, &edge, &start), joined_loops = 0;
     uint8_t *consumed = fs_calloc((size_t)n_pairs + 1, 1);
@@ -819,7 +1023,7 @@ static int32_t close_crossings(render_ctx *r, wall_point *pts, int32_t n_pts, co
         int32_t m = start[k + 1] - start[k];
         if (loop_area2(r, p, m) >= 0.0)
             continue;
-        int32_t n = junction_polygon(r, pts, pair, x, p, edge + start[k], m, consumed, poly, 64);
+        int32_t n = junction_polygon(r, pts, pair, x, p, edge + start[k], m, consumed, poly, cross, JUNCTION_CAP);
         if (n >= 3 && clip_ears(r, poly, n, false)) {
             for (int32_t c = 0; c < m; c++)
                 consumed[x[edge[start[k] + c]].pair] = 1;
@@ -990,7 +1194,8 @@ static int split_render_mesh(render_ctx *r)
      * sides (close_crossings made sure that those make a simple polygon, or joined its points) */
     cross_edge *x = fs_malloc((2 * (size_t)n_pairs + 1) * sizeof *x);
     int32_t n_x = cross_edges(r, pts, pair, n_pairs, x);
-    wall_point *loop, poly[64];
+    wall_point *loop, poly[JUNCTION_CAP];
+    uint8_t cross[JUNCTION_CAP];
     int32_t *edge, *start;
     int32_t n_loops = junction_loops(r, x, n_x, &loop, &edge, &start), merged = 0;
     uint8_t *consumed = fs_calloc((size_t)n_pairs + 1, 1);
@@ -998,11 +1203,12 @@ static int split_render_mesh(render_ctx *r)
         const wall_point *p = loop + start[k];
         int32_t size = start[k + 1] - start[k], n;
         if (loop_area2(r, p, size) >= 0.0
-            || (n = junction_polygon(r, pts, pair, x, p, edge + start[k], size, consumed, poly, 64)) < 3) {
-            clip_ears(r, p, size, true);
+            || (n = junction_polygon(r, pts, pair, x, p, edge + start[k], size, consumed, poly, cross,
+                                     JUNCTION_CAP)) < 3) {
+            emit_junction(r, p, NULL, size);
             continue;
         }
-        clip_ears(r, poly, n, true);
+        emit_junction(r, poly, cross, n);
         for (int32_t c = 0; c < size; c++)
             consumed[x[edge[start[k] + c]].pair] = 1;
         merged++;
@@ -1010,17 +1216,9 @@ static int split_render_mesh(render_ctx *r)
     for (int32_t i = 0; i < n_pairs; i++) {
         if (consumed[i])
             continue;
-        wall_point quad[4]; /* q, p, q2, p2; split along the diagonal that keeps both triangles the larger */
+        wall_point quad[4]; /* q, p, q2, p2 */
         pair_quad(r, pts, pair + 2 * i, quad);
-        const double *q = quad[0].top, *p = quad[1].top, *q2 = quad[2].top, *p2 = quad[3].top;
-        double a1 = fmin(area2(r, q, p, q2), area2(r, q, q2, p2)), a2 = fmin(area2(r, q, p, p2), area2(r, p, q2, p2));
-        if (quad[1].vertex == quad[2].vertex || quad[0].vertex == quad[3].vertex || a1 >= a2) {
-            emit_floor(r, quad + 0, quad + 1, quad + 2);
-            emit_floor(r, quad + 0, quad + 2, quad + 3);
-        } else {
-            emit_floor(r, quad + 0, quad + 1, quad + 3);
-            emit_floor(r, quad + 1, quad + 2, quad + 3);
-        }
+        emit_gap(r, quad);
     }
     free(consumed);
     fs_debug("wedge render: %d crack walls, %d points inserted on them, %d floor quads, %d junctions filled "
@@ -1053,6 +1251,7 @@ int fs_wedge_surface(const fs_wedge_model *w, fs_surface *out)
                     .wrap = {w->flat && fs_domain_wraps_u(&m->domain), w->flat && fs_domain_wraps_v(&m->domain)}};
     r.sphere = (fs_sphere_refiner){&m->domain, SPHERE_UV_TOLERANCE, out, sphere_vertex, &r};
     r.tol = 1e-9 * fmax(r.ext[0], r.ext[1]);
+    r.foot = 0.5 * fmin(fmax(w->cfg.wall_slope, 0.0), 1.0);
     r.label = fs_malloc(((size_t)w->n_elems + 1) * sizeof *r.label);
     fs_wedge_fragments(w, r.label);
     int rc = 0;
