@@ -61,28 +61,32 @@ else not_ok "at opening_scale 1: '$joined1' pieces join fragments: the measure s
 # inside the gaps, as a share of the tops' mean, is 0 with upright walls and about s / 2 with slopes
 # (a trapezoid section; a little less, as the pixels at a gap's edges, where a slope is highest, are
 # left out). mud seed 11 at 2048 x 2048, where its gaps are 6-10 pixels wide.
-# slope_run NAME SLOPE: renders; sets gap (the share) and compares mask and cell ids with upright walls.
+# slope_run NAME SLOPE UPRIGHT OPTIONS...: renders; sets gap (the share) and, unless NAME is UPRIGHT
+# (the run with upright walls), compares its mask and cell ids with that run's.
 slope_run() {
+    name=$1 slope=$2 upright=$3
+    shift 3
     gap=''
-    if ! "$FISSURE" -q -o "$tmp/$1" -n c --seed 11 --size 2048x2048 --maps crackmask,cellid,height \
-        --set render.wall_slope="$2" "$PRESETS/mud.ini" >/dev/null 2>"$tmp/stderr"; then
-        not_ok "wall_slope $2: fissure runs"; sed 's/^/    /' "$tmp/stderr" | head -5; return
+    if ! "$FISSURE" -q -o "$tmp/$name" -n c --maps crackmask,cellid,height --set render.wall_slope="$slope" "$@" \
+        >/dev/null 2>"$tmp/stderr"; then
+        not_ok "$name: fissure runs"; sed 's/^/    /' "$tmp/stderr" | head -5; return
     fi
-    set -- "$1" "$2" $("$STATS" inside "$tmp/$1/c_height.png" "$tmp/$1/c_crackmask.png" 0.999) \
-        $("$STATS" inside "$tmp/$1/c_height.png" "$tmp/$1/c_crackmask.png" 0.001)
-    [ $# -eq 6 ] && gap=$(awk "BEGIN { print $4 / $5 }")
-    if [ "$1" != slope-0 ]; then
-        cmp -s "$tmp/slope-0/c_crackmask.png" "$tmp/$1/c_crackmask.png" &&
-            cmp -s "$tmp/slope-0/c_cellid.png" "$tmp/$1/c_cellid.png" &&
-            ok "wall_slope $2: the same crack mask and fragments as upright walls" ||
-            not_ok "wall_slope $2: the crack mask or the cell ids differ from upright walls'"
+    set -- $("$STATS" inside "$tmp/$name/c_height.png" "$tmp/$name/c_crackmask.png" 0.999) \
+        $("$STATS" inside "$tmp/$name/c_height.png" "$tmp/$name/c_crackmask.png" 0.001)
+    [ $# -eq 4 ] && gap=$(awk "BEGIN { print $2 / $3 }")
+    if [ "$name" != "$upright" ]; then
+        cmp -s "$tmp/$upright/c_crackmask.png" "$tmp/$name/c_crackmask.png" &&
+            cmp -s "$tmp/$upright/c_cellid.png" "$tmp/$name/c_cellid.png" &&
+            ok "$name: the same crack mask and fragments as with upright walls" ||
+            not_ok "$name: the crack mask or the cell ids differ from upright walls'"
     fi
 }
-slope_run slope-0 0
+mud_slope() { slope_run "mud-slope-$1" "$1" mud-slope-0 --seed 11 --size 2048x2048 "$PRESETS/mud.ini"; }
+mud_slope 0
 gap0=$gap
-slope_run slope-1 1
+mud_slope 1
 gap1=$gap
-slope_run slope-06 0.6
+mud_slope 0.6
 if [ -n "$gap0" ] && awk_true "$gap0 < 0.02"; then ok "upright walls: the gaps' floor lies at the bottom ($gap0 of the tops' height)"
 else not_ok "upright walls: the gaps hold '$gap0' of the tops' height, expected under 0.02"; fi
 if [ -n "$gap1" ] && awk_true "$gap1 > 0.35 && $gap1 < 0.55"; then ok "wall_slope 1: V-shaped gaps hold $gap1 of the tops' height"
@@ -90,6 +94,14 @@ else not_ok "wall_slope 1: the gaps hold '$gap1' of the tops' height, expected 0
 if [ -n "$gap" ] && [ -n "$gap1" ] && awk_true "$gap > 0.45 * $gap1 && $gap < 0.7 * $gap1"; then
     ok "wall_slope 0.6: the gaps hold $gap of the tops' height, 0.6 of a V's about"
 else not_ok "wall_slope 0.6: the gaps hold '$gap' of the tops' height, expected 0.45-0.7 of a V's ('$gap1')"; fi
+# The shell model slopes its walls too: eggshell drawn 4 times as open (gaps 3-6 pixels wide).
+egg_slope() { slope_run "egg-slope-$1" "$1" egg-slope-0 --size 1024x512 --set render.opening_scale=4 "$PRESETS/eggshell.ini"; }
+egg_slope 0
+gap0=$gap
+egg_slope 1
+if [ -n "$gap0" ] && [ -n "$gap" ] && awk_true "$gap0 < 0.02 && $gap > 0.3 && $gap < 0.55"; then
+    ok "eggshell: the gaps hold $gap0 of the tops' height with upright walls, $gap as Vs"
+else not_ok "eggshell: the gaps hold '$gap0' of the tops' height upright, '$gap' as Vs: expected under 0.02, 0.3-0.55"; fi
 
 # The shell model draws its openings to the same scale ([shell] gap_scale times opening_scale).
 run egg-1 --size 512x256 "$PRESETS/eggshell.ini"

@@ -94,6 +94,20 @@ static void opening(const fs_shell *s, int32_t i, double d[3])
         d[k] = g * (s->x[3 * (size_t)i + k] - s->anchor[3 * (size_t)i + k]);
 }
 
+/* A top corner on the sphere: corner c of triangle t at rest, moved by its node's opening in the
+ * layer's tangent plane. */
+static void sphere_top(const fs_shell *s, int32_t t, int c, double p[3])
+{
+    int32_t i = s->mesh->tri[3 * (size_t)t + c];
+    const double *n = s->normal + 3 * (size_t)i;
+    double dd[3];
+    opening(s, i, dd);
+    fs_shell_corner(s, s->rest, t, c, p);
+    double dn = fs_dot3(dd, n);
+    for (int k = 0; k < 3; k++)
+        p[k] += dd[k] - dn * n[k];
+}
+
 /* ---- texture-space corners ---- */
 
 /* design: a vertex of the mesh appears in texture space once per chart it lies in (twice or more on
@@ -206,6 +220,26 @@ static int cmp_wall(const void *x, const void *y)
     return p->corner < q->corner ? -1 : p->corner > q->corner;
 }
 
+/* The boundary edges of the mesh (corner c: the edge from corner c to the next of its triangle),
+ * sorted by their origins, so that the two walls of a crack (the same pair of origins) come
+ * together. Returns the list (caller frees) and sets *n. */
+static wall_edge *boundary_edges(const fs_shell *s, size_t *n)
+{
+    const fs_mesh *m = s->mesh;
+    size_t nc = 3 * (size_t)m->n_tris, nw = 0;
+    wall_edge *w = fs_malloc((nc + 1) * sizeof *w);
+    for (size_t c = 0; c < nc; c++) {
+        if (m->adj[c] >= 0)
+            continue;
+        size_t next = c - c % 3 + (c + 1) % 3;
+        int32_t oa = s->origin[m->tri[c]], ob = s->origin[m->tri[next]];
+        w[nw++] = (wall_edge){oa < ob ? oa : ob, oa < ob ? ob : oa, (int32_t)c};
+    }
+    qsort(w, nw, sizeof *w, cmp_wall);
+    *n = nw;
+    return w;
+}
+
 /* Marks (border[3 t + i] = 1) every edge of the texture layout that is a border of its chart: an
  * edge of the mesh's own border, or a UV seam (the triangles across it place its ends at other
  * texture points); not a crack's wall (a boundary edge whose twin, the same pair of origins, is the
@@ -213,9 +247,6 @@ static int cmp_wall(const void *x, const void *y)
 static void chart_borders(const fs_shell *s, const corner_groups *g, uint8_t *border)
 {
     const fs_mesh *m = s->mesh;
-    size_t nc = 3 * (size_t)m->n_tris;
-    wall_edge *w = fs_malloc((nc + 1) * sizeof *w);
-    size_t nw = 0;
     for (int32_t t = 0; t < m->n_tris; t++)
         for (int i = 0; i < 3; i++) {
             size_t c = 3 * (size_t)t + i;
@@ -228,12 +259,10 @@ static void chart_borders(const fs_shell *s, const corner_groups *g, uint8_t *bo
                 if (ca >= 0 && cb >= 0 &&
                     (g->group[3 * (size_t)u + ca] != g->group[c] || g->group[3 * (size_t)u + cb] != g->group[3 * (size_t)t + (i + 1) % 3]))
                     border[c] = 1;
-                continue;
             }
-            int32_t oa = s->origin[m->tri[c]], ob = s->origin[m->tri[3 * (size_t)t + (i + 1) % 3]];
-            w[nw++] = (wall_edge){oa < ob ? oa : ob, oa < ob ? ob : oa, (int32_t)c};
         }
-    qsort(w, nw, sizeof *w, cmp_wall);
+    size_t nw;
+    wall_edge *w = boundary_edges(s, &nw);
     for (size_t k = 0; k < nw;) {
         size_t j = k;
         while (j < nw && w[j].a == w[k].a && w[j].b == w[k].b)
@@ -304,6 +333,89 @@ static void add_skirts(const fs_shell *s, const corner_groups *g, const attr *to
     free(edge_n);
 }
 
+/* ---- sloping walls ([render] wall_slope) ---- */
+
+/* Where corner c's top is drawn: its texture point (2 numbers), or on the sphere its 3-D point. */
+static void top_point(const fs_shell *s, const corner_groups *g, size_t c, double *p)
+{
+    if (s->mesh->domain.type == FS_DOMAIN_SPHERE) {
+        sphere_top(s, (int32_t)(c / 3), (int)(c % 3), p);
+        return;
+    }
+    memcpy(p, g->moved + 2 * (size_t)g->group[c], 2 * sizeof *p);
+}
+
+/* The slope down from the wall edge at corner c (to the next corner of its triangle) to its feet,
+ * `foot` of the way to the points of the same origins on the wall across, whose edge is at corner
+ * c2. Unless the wall across lies in another chart of the texture layout (a crack along a UV seam:
+ * its rest points are elsewhere, not a whole period away). */
+static void emit_slope(render_ctx *r, const corner_groups *g, const attr *top, size_t c, size_t c2, double foot)
+{
+    const fs_shell *s = r->s;
+    const fs_mesh *m = s->mesh;
+    bool sphere = m->domain.type == FS_DOMAIN_SPHERE;
+    int dim = sphere ? 3 : 2;
+    size_t mine[2] = {c, c - c % 3 + (c + 1) % 3}, across[2] = {c2, c2 - c2 % 3 + (c2 + 1) % 3};
+    if (s->origin[m->tri[across[0]]] != s->origin[m->tri[mine[0]]]) {
+        size_t t = across[0];
+        across[0] = across[1];
+        across[1] = t;
+    }
+    double pt[4][3] = {{0.0}}, shift[2] = {0.0, 0.0};
+    attr a[4];
+    for (int e = 0; e < 2; e++) {
+        double far[3] = {0.0, 0.0, 0.0};
+        top_point(s, g, mine[e], pt[e]);
+        top_point(s, g, across[e], far);
+        if (!sphere) {
+            const double *r0 = g->rest + 2 * (size_t)g->group[mine[e]], *r1 = g->rest + 2 * (size_t)g->group[across[e]];
+            bool wraps[2] = {fs_domain_wraps_u(&m->domain), fs_domain_wraps_v(&m->domain)};
+            for (int k = 0; k < 2; k++) {
+                shift[k] = wraps[k] ? round(r0[k] - r1[k]) : 0.0;
+                if (fabs(r0[k] - r1[k] - shift[k]) > 1e-9)
+                    return;
+            }
+        }
+        for (int k = 0; k < dim; k++)
+            pt[3 - e][k] = pt[e][k] + foot * (far[k] + (k < 2 && !sphere ? shift[k] : 0.0) - pt[e][k]);
+        a[e] = (attr){top[mine[e]].height * 0.999, 1.0, 0.0, 0.0}; /* under the top it meets (add_skirts) */
+        a[3 - e] = (attr){0.0, 1.0, 0.0, 0.0};
+    }
+    static const int tris[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int k = 0; k < 2; k++) {
+        double uv[6], p[9];
+        attr at[3];
+        for (int q = 0; q < 3; q++) {
+            const double *x = pt[tris[k][q]];
+            at[q] = a[tris[k][q]];
+            memcpy(p + 3 * q, x, 3 * sizeof *x);
+            uv[2 * q] = x[0];
+            uv[2 * q + 1] = x[1];
+        }
+        emit(r, uv, sphere ? p : NULL, at);
+    }
+}
+
+/* design: the floor lies under the whole layer and the maps show the highest surface, so a crack's
+ * walls slope where a slope is drawn from each wall's top edge down to its feet, half of
+ * [render] wall_slope of the way across to the points of the same origins on the wall across; the
+ * floor shows between the feet, and where cracks meet the slopes overlap. */
+static void add_slopes(render_ctx *r, const corner_groups *g, const attr *top)
+{
+    double foot = 0.5 * fmin(fmax(r->s->cfg.wall_slope, 0.0), 1.0);
+    if (!(foot > 0.0))
+        return;
+    size_t nw;
+    wall_edge *w = boundary_edges(r->s, &nw);
+    for (size_t k = 0; k + 1 < nw; k++)
+        if (w[k].a == w[k + 1].a && w[k].b == w[k + 1].b && (k + 2 == nw || w[k + 2].a != w[k].a || w[k + 2].b != w[k].b)
+            && (k == 0 || w[k - 1].a != w[k].a || w[k - 1].b != w[k].b)) {
+            emit_slope(r, g, top, (size_t)w[k].corner, (size_t)w[k + 1].corner, foot);
+            emit_slope(r, g, top, (size_t)w[k + 1].corner, (size_t)w[k].corner, foot);
+        }
+    free(w);
+}
+
 int fs_shell_surface(const fs_shell *s, fs_surface *out)
 {
     const fs_mesh *m = s->mesh;
@@ -344,9 +456,7 @@ int fs_shell_surface(const fs_shell *s, fs_surface *out)
             opening(s, i, dd);
             a[c] = (attr){h + fs_dot3(dd, n) / s->cfg.shell.gap_scale, 0.0, (double)(label[t] % 65535 + 1), shade};
             if (sphere) {
-                fs_shell_corner(s, s->rest, t, c, p + 3 * c);
-                for (int k = 0; k < 3; k++)
-                    p[3 * c + k] += dd[k] - fs_dot3(dd, s->normal + 3 * (size_t)i) * s->normal[3 * (size_t)i + k];
+                sphere_top(s, t, c, p + 3 * c);
                 continue;
             }
             const double *moved = g.moved + 2 * (size_t)g.group[3 * (size_t)t + c];
@@ -361,6 +471,7 @@ int fs_shell_surface(const fs_shell *s, fs_surface *out)
         }
         emit(&r, uv, sphere ? p : NULL, a);
     }
+    add_slopes(&r, &g, top);
     if (d->type == FS_DOMAIN_MESH)
         add_skirts(s, &g, top, out);
     groups_free(&g);
