@@ -259,12 +259,28 @@ typedef struct {
     int32_t e;
 } bound_entry;
 
-static int cmp_bound_desc(const void *a, const void *b)
+/* Whether x comes before y: the larger bound first, the smaller element on a tie. */
+static bool bound_before(const bound_entry *x, const bound_entry *y)
 {
-    const bound_entry *x = a, *y = b;
-    if (x->bound != y->bound)
-        return x->bound < y->bound ? 1 : -1;
-    return (x->e > y->e) - (x->e < y->e);
+    return x->bound != y->bound ? x->bound > y->bound : x->e < y->e;
+}
+
+/* Moves h[i] down the binary heap h (n entries, the first in bound_before order at the root). */
+static void heap_down(bound_entry *h, int32_t n, int32_t i)
+{
+    for (;;) {
+        int32_t l = 2 * i + 1, r = l + 1, top = i;
+        if (l < n && bound_before(h + l, h + top))
+            top = l;
+        if (r < n && bound_before(h + r, h + top))
+            top = r;
+        if (top == i)
+            return;
+        bound_entry t = h[i];
+        h[i] = h[top];
+        h[top] = t;
+        i = top;
+    }
 }
 
 /* design: thesis §5.6.1 evaluates the stress at the three Gauss points nearest the top face ("the
@@ -273,7 +289,9 @@ static int cmp_bound_desc(const void *a, const void *b)
  * has it (fracture/rank.h, ties within FS_RANK_TIE_REL), so the shared eigen kernel runs only on the
  * elements whose upper bound (fs_eigen_principal_bound) could reach the largest exact ratio, in
  * descending order of the bound, until the next bound falls below the best exact ratio found (less
- * the tie tolerance). Every other ratio holds its bound.
+ * the tie tolerance). Every other ratio holds its bound. Where the layer holds many elements over 1
+ * that do not break (Griffith's criterion stops cracks), the candidates come off a binary heap, in
+ * the same order as a sort, which would cost n log n at every call for the few that are needed.
  * With lazy_ratios, an element evaluated before at the same shrinkage and eigenstrain is not evaluated
  * again while its old bound plus ratio_lipschitz times the change of its nodal displacements stays at
  * most LAZY_LEVEL: that sum bounds the exact ratio too. After a removal the displacements change
@@ -343,17 +361,21 @@ int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_e
         for (int32_t e = 0; e < w->n_elems; e++)
             if (w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0)
                 list[n++] = (bound_entry){w->ratio[e], e};
-        qsort(list, (size_t)n, sizeof *list, cmp_bound_desc);
+        for (int32_t i = n / 2 - 1; i >= 0; i--)
+            heap_down(list, n, i);
         double best = -INFINITY;
-        for (int32_t q = 0; q < n; q++) {
-            if (list[q].bound < best - 2.0 * FS_RANK_TIE_REL * fabs(best))
+        for (int32_t left = n; left > 0;) {
+            bound_entry next = list[0];
+            if (next.bound < best - 2.0 * FS_RANK_TIE_REL * fabs(best))
                 break;
-            double r = fs_wedge_element_ratio(w, list[q].e);
+            list[0] = list[--left];
+            heap_down(list, left, 0);
+            double r = fs_wedge_element_ratio(w, next.e);
             if (isnan(r)) {
                 free(list);
                 return -1;
             }
-            w->ratio[list[q].e] = r;
+            w->ratio[next.e] = r;
             best = fmax(best, r);
         }
         free(list);
