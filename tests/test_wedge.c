@@ -618,6 +618,48 @@ static void test_thickness_over_time(void)
     fs_mesh_free(&m2);
 }
 
+/* A thickening layer keeps each element's stiffness as h K1 + K0 + K2 / h (system.c): at any base
+ * thickness it equals the quadrature's, with the nodes' thickness factors uneven across the element
+ * (a thickness gradient), and it follows a changed factor. */
+static void test_stiffness_parts(void)
+{
+    fs_config cfg = base_config();
+    cfg.domain.width = 3.0;
+    cfg.domain.height = 2.0;
+    cfg.material.thickness = 0.2;
+    cfg.material.thickness_final = 0.6;
+    cfg.wedge.thickness_gradient = 0.8;
+    fs_mesh m = {0};
+    CHECK(wedge_test_mesh(&cfg, 150, &m) == 0);
+    fs_wedge_model w;
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
+    CHECK(w.k_parts_on);
+    double K[324], direct[324], x[18], D[36], loads[FS_WEDGE_PATTERNS][18], worst = 0.0;
+    for (int round = 0; round < 2; round++) {
+        if (round == 1) /* a node of element 0 thicker: its parts are refitted */
+            w.thickness_factor[m.tri[0]] *= 1.5;
+        static const double hs[3] = {0.05, 0.4, 3.0};
+        for (int32_t e = 0; e < w.n_elems; e++)
+            for (int i = 0; i < 3; i++) {
+                CHECK(fs_wedge_element_system(&w, e, hs[i], K, loads) == 0);
+                fs_wedge_coords_at(&w, e, hs[i], x);
+                for (int k = 0; k < 36; k++)
+                    D[k] = w.young[e] * w.d_unit[k];
+                CHECK(fs_wedge_stiffness(x, D, direct) == 0);
+                double scale = 0.0, diff = 0.0;
+                for (int p = 0; p < 324; p++) {
+                    scale = fmax(scale, fabs(direct[p]));
+                    diff = fmax(diff, fabs(K[p] - direct[p]));
+                }
+                worst = fmax(worst, diff / scale);
+            }
+    }
+    CHECK_MSG(worst < 1e-11, "stiffness from its parts differs from the quadrature by %.3g", worst);
+    printf("  stiffness from its parts against the quadrature: %.3g relative\n", worst);
+    fs_wedge_free(&w);
+    fs_mesh_free(&m);
+}
+
 /* The thickness gradient and a grey-level thickness map scale the layer node by node: the render
  * mesh's heights are the thickness times 1 + gradient (u - 1/2) times the map's grey level. */
 static void test_thickness_gradient_and_map(void)
@@ -668,6 +710,7 @@ int main(void)
     RUN(test_subdivision_run);
     RUN(test_lazy_ratios);
     RUN(test_thickness_over_time);
+    RUN(test_stiffness_parts);
     RUN(test_thickness_gradient_and_map);
     return check_finish();
 }

@@ -45,6 +45,10 @@
  * MPa cm^2. Voigt order and stress conventions as in model/wedge/element.h. */
 
 /* Unit load patterns per element: three of shrinkage, three of eigenstrain (see wedge.c). */
+/* Inputs of an element's stiffness parts (k_parts): its corners' x and y, their thickness factors,
+ * its Young's modulus. */
+#define FS_WEDGE_K_KEY 10
+
 #define FS_WEDGE_PATTERNS 6
 
 /* How an element left the model. */
@@ -134,6 +138,10 @@ struct fs_wedge_model {
     int32_t n_elems;
     uint8_t *state;              /* fs_wedge_state per element */
     double *young;               /* per element: Young's modulus (MPa), with the map */
+    bool k_parts_on;             /* the layer's thickness changes in time on a flat frame */
+    double *k_parts;             /* per element, 3 x 324, with k_parts_on (else NULL): K1, K0, K2 of its stiffness
+                                    h K1 + K0 + K2 / h at base thickness h (fs_wedge_element_system) */
+    double *k_key;               /* per element, FS_WEDGE_K_KEY: the inputs k_parts were fitted to */
     double *threshold;           /* per element: threshold stress (MPa), with the map and jitter */
     double *ratio;               /* per element, at the current equilibrium: the largest principal
                                     stress at the three top Gauss points over the threshold, or an

@@ -106,7 +106,8 @@ typedef struct {
     double foot;     /* split: where a sloping wall meets the floor, as a share of the floor's width
                       * from the wall (half of [render] wall_slope); 0: upright walls */
     int32_t feet;    /* split: feet drawn so far (they are points of the surface of their own) */
-    bool fan_ears;   /* split: clip_ears draws each ear as a fan from a point of floor at its centroid */
+    bool fan_ears;   /* split: clip_ears dips the ears' diagonals between two corners to the floor
+                      * (emit_ear) */
 } render_ctx;
 
 /* fs_sphere_refiner.vertex: a vertex with the attributes of the triangle's corners mixed by w. */

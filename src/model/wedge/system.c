@@ -173,6 +173,53 @@ int32_t fs_wedge_alive_at_node(const fs_wedge_model *w, int32_t i)
 
 /* ---- element matrices ---- */
 
+/* design: a layer whose thickness changes in time ([material] thickness_final) is assembled anew at
+ * every equilibrium at a new thickness. On a flat frame an element is a prism whose top corners lie
+ * h f_i above its bottom corners (h the base thickness, f_i the nodes' thickness factors), so with
+ * z = zeta h F(xi, eta) its Jacobian's determinant is h F det J2 and its strain-displacement
+ * matrix is a part free of h plus 1 / h times the d/dzeta part: over the same Gauss points the
+ * stiffness is exactly K(h) = h K1 + K0 + K2 / h. The three parts are fitted once from the
+ * stiffness at h / 2, h and 2 h and kept with the inputs they were fitted to (k_key: corners,
+ * thickness factors, Young's modulus), and refitted when these change; every other thickness costs
+ * two multiply-adds an entry instead of a quadrature. */
+static int element_stiffness(const fs_wedge_model *w, int32_t e, double h, const double x[18], const double D[36],
+                             double K[324])
+{
+    if (!w->k_parts_on)
+        return fs_wedge_stiffness(x, D, K);
+    double key[FS_WEDGE_K_KEY];
+    for (int c = 0; c < 3; c++) {
+        key[2 * c] = x[3 * c];
+        key[2 * c + 1] = x[3 * c + 1];
+        key[6 + c] = w->thickness_factor[w->mesh->tri[3 * (size_t)e + c]];
+    }
+    key[9] = w->young[e];
+    double *parts = w->k_parts + 3 * 324 * (size_t)e, *kept = w->k_key + FS_WEDGE_K_KEY * (size_t)e;
+    if (memcmp(key, kept, sizeof key) != 0) {
+        /* K(a_i) = a_i K1 + K0 + K2 / a_i at a = h/2, h, 2h, solved for the parts entry by entry:
+         * the inverse of [[a_i, 1, 1/a_i]] is [[2, -6, 4], [-6, 15, -6], [4, -6, 2]] / 3 with its
+         * rows scaled by 1/h, 1 and h */
+        static const double inv[3][3] = {{2.0, -6.0, 4.0}, {-6.0, 15.0, -6.0}, {4.0, -6.0, 2.0}};
+        double (*ka)[324] = fs_malloc(3 * sizeof *ka), xa[18];
+        for (int i = 0; i < 3; i++) {
+            fs_wedge_coords_at(w, e, h * (i == 0 ? 0.5 : i == 1 ? 1.0 : 2.0), xa);
+            if (fs_wedge_stiffness(xa, D, ka[i]) < 0) {
+                free(ka);
+                return -1;
+            }
+        }
+        double row_scale[3] = {1.0 / (3.0 * h), 1.0 / 3.0, h / 3.0};
+        for (int j = 0; j < 3; j++)
+            for (int p = 0; p < 324; p++)
+                parts[324 * j + p] = row_scale[j] * (inv[j][0] * ka[0][p] + inv[j][1] * ka[1][p] + inv[j][2] * ka[2][p]);
+        free(ka);
+        memcpy(kept, key, sizeof key);
+    }
+    for (int p = 0; p < 324; p++)
+        K[p] = h * parts[p] + parts[324 + p] + parts[648 + p] / h;
+    return 0;
+}
+
 int fs_wedge_element_system(const fs_wedge_model *w, int32_t e, double base_thickness, double K[324],
                              double loads[FS_WEDGE_PATTERNS][18])
 {
@@ -180,7 +227,7 @@ int fs_wedge_element_system(const fs_wedge_model *w, int32_t e, double base_thic
     fs_wedge_coords_at(w, e, base_thickness, x);
     for (int i = 0; i < 36; i++)
         D[i] = w->young[e] * w->d_unit[i];
-    if (fs_wedge_stiffness(x, D, K) < 0) {
+    if (element_stiffness(w, e, base_thickness, x, D, K) < 0) {
         fs_error(FS_ERR_DATA, "wedge model: element %d is inverted or degenerate (%s)", (int)e, fs_error_message());
         return -1;
     }

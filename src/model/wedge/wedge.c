@@ -171,6 +171,12 @@ void fs_wedge_grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
     }
     w->state = fs_realloc(w->state, ne * sizeof *w->state);
     w->young = fs_realloc(w->young, ne * sizeof *w->young);
+    if (w->k_parts_on) {
+        w->k_parts = fs_realloc(w->k_parts, 3 * 324 * ne * sizeof *w->k_parts);
+        w->k_key = fs_realloc(w->k_key, FS_WEDGE_K_KEY * ne * sizeof *w->k_key);
+        for (size_t q = FS_WEDGE_K_KEY * (size_t)w->n_elems; q < FS_WEDGE_K_KEY * ne; q++)
+            w->k_key[q] = NAN;
+    }
     w->threshold = fs_realloc(w->threshold, ne * sizeof *w->threshold);
     w->ratio = fs_realloc(w->ratio, ne * sizeof *w->ratio);
     w->stress_top = fs_realloc(w->stress_top, 18 * ne * sizeof *w->stress_top);
@@ -209,6 +215,8 @@ static int init_model(fs_wedge_model *w, fs_mesh *mesh, const fs_model_setup *cf
     fs_domain_normalize(&w->mesh->domain);
     const fs_domain *d = &mesh->domain;
     w->flat = d->type != FS_DOMAIN_SPHERE;
+    w->k_parts_on = w->flat && fs_material_thickness(&cfg->material, 0.0, cfg->time.end)
+                                   != fs_material_thickness(&cfg->material, cfg->time.end, cfg->time.end);
     w->time = 0.0;
 
     if (fs_wedge_elasticity(1.0, cfg->material.poisson, w->d_unit) < 0 || !(cfg->material.young > 0.0) ||
@@ -270,6 +278,8 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->u);
     free(w->state);
     free(w->young);
+    free(w->k_parts);
+    free(w->k_key);
     free(w->threshold);
     free(w->ratio);
     free(w->stress_top);
