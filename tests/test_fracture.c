@@ -721,6 +721,35 @@ static void test_tip_stress_surface(void)
 }
 
 /* Eq. 28: m(a) has eigenvalue |a| along a, 0 across it; m(0) = 0. */
+/* A plane stress turned into 3-D: in the frame's own axes the components stay where they were; in a
+ * tilted frame the trace is sxx + syy, the frame's normal is a principal direction with stress 0,
+ * and the stress along e1 and across e1, e2 reads back sxx and sxy. */
+static void test_plane_stress_voigt(void)
+{
+    const double ex[3] = {1, 0, 0}, ey[3] = {0, 1, 0}, plane[3] = {3.0, -1.0, 0.5};
+    double out[6];
+    fs_plane_stress_voigt(ex, ey, plane, out);
+    const double expect[6] = {3.0, -1.0, 0.0, 0.5, 0.0, 0.0};
+    for (int k = 0; k < 6; k++)
+        CHECK_NEAR(out[k], expect[k], 1e-15);
+    double a = 0.7, b = 0.3;
+    const double e1[3] = {cos(a), sin(a) * cos(b), sin(a) * sin(b)};
+    const double e2[3] = {-sin(a), cos(a) * cos(b), cos(a) * sin(b)};
+    double n[3];
+    fs_cross3(n, e1, e2);
+    fs_plane_stress_voigt(e1, e2, plane, out);
+    double m[3][3] = {{out[0], out[3], out[5]}, {out[3], out[1], out[4]}, {out[5], out[4], out[2]}};
+    CHECK_NEAR(out[0] + out[1] + out[2], plane[0] + plane[1], 1e-14);
+    double mn[3], me1[3];
+    for (int i = 0; i < 3; i++) {
+        mn[i] = m[i][0] * n[0] + m[i][1] * n[1] + m[i][2] * n[2];
+        me1[i] = m[i][0] * e1[0] + m[i][1] * e1[1] + m[i][2] * e1[2];
+    }
+    CHECK(fs_norm3(mn) < 1e-14);
+    CHECK_NEAR(fs_dot3(me1, e1), plane[0], 1e-14);
+    CHECK_NEAR(fs_dot3(me1, e2), plane[2], 1e-14);
+}
+
 static void test_separation_m(void)
 {
     double z[9] = {0};
@@ -880,6 +909,7 @@ int main(void)
     RUN(test_nodal_principal_plane);
     RUN(test_tip_stress);
     RUN(test_tip_stress_surface);
+    RUN(test_plane_stress_voigt);
     RUN(test_separation_m);
     RUN(test_separation_split_stress);
     RUN(test_separation_tensor_cases);

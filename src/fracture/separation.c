@@ -42,6 +42,14 @@ static void turn(const double r[3][3], const double m[3][3], double out[6])
     }
 }
 
+void fs_plane_stress_voigt(const double e1[3], const double e2[3], const double plane[3], double out[6])
+{
+    for (int k = 0; k < 6; k++) {
+        int i = voigt_row[k], j = voigt_col[k];
+        out[k] = plane[0] * e1[i] * e1[j] + plane[1] * e2[i] * e2[j] + plane[2] * (e1[i] * e2[j] + e2[i] * e1[j]);
+    }
+}
+
 void fs_tip_stress_begin(fs_tip_stress *a, const double ahead[3], const double normal[3], double radius)
 {
     memset(a, 0, sizeof *a);

@@ -81,6 +81,10 @@ void fs_tip_stress_add(fs_tip_stress *a, const double offset[3], const double no
  * zeroed) when no sample ahead of the tip had weight. */
 bool fs_tip_stress_mean(const fs_tip_stress *a, double mean[6]);
 
+/* The 3-D Voigt stress of the plane stress (plane: sxx, syy, sxy) in the orthonormal frame e1, e2 of
+ * a surface: sxx e1 e1^T + syy e2 e2^T + sxy (e1 e2^T + e2 e1^T). */
+void fs_plane_stress_voigt(const double e1[3], const double e2[3], const double plane[3], double out[6]);
+
 /* The largest principal stress of a Voigt stress into *sigma1 and, if normal is not NULL, the unit
  * normal of its principal plane (the eigenvector of sigma1, oriented as fs_eigen_sym3 orients it).
  * Returns 0, or -1 with fs_error (FS_ERR_INTERNAL) if an entry is not finite (outputs zeroed). */

@@ -11,6 +11,7 @@
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "fracture/event.h"
+#include "fracture/separation.h"
 
 /* design: Gingold et al. §"Fracture": a face fails where a principal value of the strain
  * E(z) = Em + z Ec at z = +-h/2 passes a threshold. fissure's presets give the threshold as a stress
@@ -98,17 +99,10 @@ static double critical_stress(const fs_shell *s, int32_t t, double plane[3], dou
 static double face_criterion(const fs_shell *s, int32_t t, double m[2], double stress[6])
 {
     double plane[3], sigma1 = critical_stress(s, t, plane, m);
-    if (stress) {
-        /* sxx e1 e1^T + syy e2 e2^T + sxy (e1 e2^T + e2 e1^T), Voigt xx, yy, zz, xy, yz, zx */
-        const double *e1 = s->frame + 6 * (size_t)t, *e2 = e1 + 3;
-        static const int row[6] = {0, 1, 2, 0, 1, 2}, col[6] = {0, 1, 2, 1, 2, 0};
-        for (int k = 0; k < 6; k++) {
-            int i = row[k], j = col[k];
-            stress[k] = isfinite(sigma1) ? plane[0] * e1[i] * e1[j] + plane[1] * e2[i] * e2[j] +
-                                               plane[2] * (e1[i] * e2[j] + e2[i] * e1[j])
-                                         : 0.0;
-        }
-    }
+    if (stress && isfinite(sigma1))
+        fs_plane_stress_voigt(s->frame + 6 * (size_t)t, s->frame + 6 * (size_t)t + 3, plane, stress);
+    else if (stress)
+        memset(stress, 0, 6 * sizeof *stress);
     return sigma1 / s->threshold[t];
 }
 
