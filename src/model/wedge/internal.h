@@ -45,11 +45,11 @@
  * MPa cm^2. Voigt order and stress conventions as in model/wedge/element.h. */
 
 /* Unit load patterns per element: three of shrinkage, three of eigenstrain (see wedge.c). */
+#define FS_WEDGE_PATTERNS 6
+
 /* Inputs of an element's stiffness parts (k_parts): its corners' x and y, their thickness factors,
  * its Young's modulus. */
 #define FS_WEDGE_K_KEY 10
-
-#define FS_WEDGE_PATTERNS 6
 
 /* How an element left the model. */
 typedef enum { FS_WEDGE_ALIVE = 0, FS_WEDGE_REMOVED = 1 } fs_wedge_state;

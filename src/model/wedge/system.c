@@ -178,10 +178,12 @@ int32_t fs_wedge_alive_at_node(const fs_wedge_model *w, int32_t i)
  * h f_i above its bottom corners (h the base thickness, f_i the nodes' thickness factors), so with
  * z = zeta h F(xi, eta) its Jacobian's determinant is h F det J2 and its strain-displacement
  * matrix is a part free of h plus 1 / h times the d/dzeta part: over the same Gauss points the
- * stiffness is exactly K(h) = h K1 + K0 + K2 / h. The three parts are fitted once from the
- * stiffness at h / 2, h and 2 h and kept with the inputs they were fitted to (k_key: corners,
- * thickness factors, Young's modulus), and refitted when these change; every other thickness costs
- * two multiply-adds an entry instead of a quadrature. */
+ * stiffness is exactly K(h) = h K1 + K0 + K2 / h. The three parts are fitted from the stiffness at
+ * h / 2, h and 2 h the second time an element is assembled with the same inputs (k_key: corners,
+ * thickness factors, Young's modulus; the first time it is integrated directly, so that a layer
+ * whose corners move, as under growth on a plane that does not wrap, costs no more than without
+ * the parts), and refitted when the inputs change; every other thickness costs two multiply-adds
+ * an entry instead of a quadrature. */
 static int element_stiffness(const fs_wedge_model *w, int32_t e, double h, const double x[18], const double D[36],
                              double K[324])
 {
@@ -195,7 +197,12 @@ static int element_stiffness(const fs_wedge_model *w, int32_t e, double h, const
     }
     key[9] = w->young[e];
     double *parts = w->k_parts + 3 * 324 * (size_t)e, *kept = w->k_key + FS_WEDGE_K_KEY * (size_t)e;
-    if (memcmp(key, kept, sizeof key) != 0) {
+    if (memcmp(key, kept, sizeof key) != 0) { /* new inputs: integrate, fit next time */
+        memcpy(kept, key, sizeof key);
+        parts[0] = NAN;
+        return fs_wedge_stiffness(x, D, K);
+    }
+    if (isnan(parts[0])) {
         /* K(a_i) = a_i K1 + K0 + K2 / a_i at a = h/2, h, 2h, solved for the parts entry by entry:
          * the inverse of [[a_i, 1, 1/a_i]] is [[2, -6, 4], [-6, 15, -6], [4, -6, 2]] / 3 with its
          * rows scaled by 1/h, 1 and h */
@@ -213,7 +220,6 @@ static int element_stiffness(const fs_wedge_model *w, int32_t e, double h, const
             for (int p = 0; p < 324; p++)
                 parts[324 * j + p] = row_scale[j] * (inv[j][0] * ka[0][p] + inv[j][1] * ka[1][p] + inv[j][2] * ka[2][p]);
         free(ka);
-        memcpy(kept, key, sizeof key);
     }
     for (int p = 0; p < 324; p++)
         K[p] = h * parts[p] + parts[324 + p] + parts[648 + p] / h;
