@@ -79,6 +79,9 @@ family shell eggshell --size 128x64 --set mesh.elements=600 --frames 2
 # large enough that the shell's whole-shell passes (bending angles, triangle terms, fracture ratios)
 # run on two threads (energy.c: from 4096 items)
 family shell-passes eggshell --size 128x64 --set mesh.elements=4200
+# a thickening wedge layer large enough that its refills (element systems, from 256 elements) and
+# its whole-layer stress passes (from 2048 elements) run on two threads
+family wedge-passes bark-j --size 64x64 --set mesh.elements=2600
 # Without -j the BLAS's and the rasteriser's own settings do not matter either.
 OPENBLAS_NUM_THREADS=2 OMP_NUM_THREADS=2 LP_NUM_THREADS=3 "$FISSURE" -q -o "$tmp/f-springs-env" -n o \
     --mesh "$tmp/f-springs-env/o.obj" --maps all --set render.preview_size=160x120 --size 256x256 \

@@ -64,3 +64,28 @@ void fs_parallel_for(int32_t n, int threads, fs_parallel_fn fn, void *ctx)
         if (started[t])
             pthread_join(thread[t], NULL);
 }
+
+typedef struct {
+    fs_range_fn fn;
+    void *ctx;
+    int32_t n;
+} range_work;
+
+static void range_part(void *ctx, int32_t part)
+{
+    const range_work *w = ctx;
+    int32_t i0, i1;
+    fs_parallel_part(w->n, FS_RANGE_PARTS, part, &i0, &i1);
+    w->fn(w->ctx, i0, i1);
+}
+
+void fs_parallel_ranges(int32_t n, int32_t min_items, fs_range_fn fn, void *ctx)
+{
+    if (n < min_items) {
+        if (n > 0)
+            fn(ctx, 0, n);
+        return;
+    }
+    range_work w = {fn, ctx, n};
+    fs_parallel_for(FS_RANGE_PARTS, 0, range_part, &w);
+}

@@ -41,6 +41,18 @@ typedef void (*fs_parallel_fn)(void *ctx, int32_t i);
  * everything). Nothing happens for n <= 0. */
 void fs_parallel_for(int32_t n, int threads, fs_parallel_fn fn, void *ctx);
 
+/* Work over the items [i0, i1) of a range. */
+typedef void (*fs_range_fn)(void *ctx, int32_t i0, int32_t i1);
+
+/* design: a pass over many cheap items (every element's stress, every hinge of a shell) runs in
+ * FS_RANGE_PARTS fixed contiguous parts (fs_parallel_part) on fs_threads() threads, each part calling
+ * fn on its range; whatever sums over items is left to the caller, in item order, so the results are
+ * the same for any thread count and the same as one loop. A pass of fewer than min_items items runs
+ * on the calling thread alone (starting threads costs tens of microseconds). fn(ctx, i0, i1) must
+ * write only the slots of its own items. */
+#define FS_RANGE_PARTS 32
+void fs_parallel_ranges(int32_t n, int32_t min_items, fs_range_fn fn, void *ctx);
+
 /* Part p of [0, n) cut into parts contiguous ranges of sizes differing by at most one:
  * [n p / parts, n (p + 1) / parts), into *i0 and *i1. 0 <= p < parts. */
 static inline void fs_parallel_part(int32_t n, int parts, int p, int32_t *i0, int32_t *i1)

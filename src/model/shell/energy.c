@@ -247,37 +247,14 @@ static void hinge_phi_at(fs_shell *s, const double *p, int32_t h, bool with_grad
 /* design: the whole shell is evaluated thousands of times a run (every Newton step of every
  * equilibrium, every test of the fracture criterion), each time over every hinge and triangle. The
  * per-hinge and per-triangle work (bending angles, strains, stresses, a triangle's own forces) runs
- * on fs_threads() threads in PASS_PARTS fixed parts, each item writing only its own slots; whatever
- * sums over items (energy, nodal forces) is then added up in item order on one thread: the same
- * floating-point operations in the same order as one loop, so the results are the same for any
+ * in fixed parts on several threads (fs_parallel_ranges), each item writing only its own slots;
+ * whatever sums over items (energy, nodal forces) is then added up in item order on one thread: the
+ * same floating-point operations in the same order as one loop, so the results are the same for any
  * thread count, and the same as before the passes were split. Scopes of fewer than PASS_MIN items
  * (a local relaxation's) stay on the calling thread. */
-#define PASS_PARTS 32
 #define PASS_MIN 4096
 
-typedef struct {
-    fs_shell_range_fn fn;
-    void *ctx;
-    int32_t n;
-} pass_work;
-
-static void pass_part(void *ctx, int32_t part)
-{
-    const pass_work *w = ctx;
-    int32_t i0, i1;
-    fs_parallel_part(w->n, PASS_PARTS, part, &i0, &i1);
-    w->fn(w->ctx, i0, i1);
-}
-
-void fs_shell_parallel(int32_t n, fs_shell_range_fn fn, void *ctx)
-{
-    if (n < PASS_MIN) {
-        fn(ctx, 0, n);
-        return;
-    }
-    pass_work w = {fn, ctx, n};
-    fs_parallel_for(PASS_PARTS, 0, pass_part, &w);
-}
+void fs_shell_parallel(int32_t n, fs_range_fn fn, void *ctx) { fs_parallel_ranges(n, PASS_MIN, fn, ctx); }
 
 typedef struct {
     fs_shell *s;

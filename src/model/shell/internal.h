@@ -5,6 +5,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "base/threads.h"
 #include "field/growth.h"
 #include "geom/mesh.h"
 #include "model/model.h"
@@ -237,12 +238,10 @@ void fs_shell_corner(const fs_shell *s, const double *p, int32_t t, int c, doubl
  * edge phi in s->phi (call fs_shell_update_phi first). */
 void fs_shell_strains(const fs_shell *s, const double *p, int32_t t, double em[3], double ec[3]);
 
-/* Work over items [i0, i1) of a whole-shell pass. */
-typedef void (*fs_shell_range_fn)(void *ctx, int32_t i0, int32_t i1);
-
-/* Runs fn over the items [0, n) on fs_threads() threads in fixed parts (energy.c design), or on the
- * calling thread alone for few items. fn(ctx, i0, i1) must write only the slots of its own items. */
-void fs_shell_parallel(int32_t n, fs_shell_range_fn fn, void *ctx);
+/* Runs fn over the items [0, n) on several threads in fixed parts (fs_parallel_ranges), or on the
+ * calling thread alone for few items (energy.c design). fn(ctx, i0, i1) must write only the slots of
+ * its own items. */
+void fs_shell_parallel(int32_t n, fs_range_fn fn, void *ctx);
 
 /* Recomputes s->phi (and s->dphi when with_grad) of every hinge at positions p. */
 void fs_shell_update_phi(fs_shell *s, const double *p, bool with_grad);

@@ -9,6 +9,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "base/threads.h"
 #include "base/vec.h"
 #include "fracture/eigen.h"
 #include "fracture/rank.h"
@@ -185,11 +186,20 @@ static double ratio_lipschitz(const fs_wedge_model *w, int32_t e, const double *
 {
     double worst = 0.0;
     for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
+        const double *dndx = cache + 18 * g;
         double sum = 0.0;
         for (int a = 0; a < 18; a++) {
-            double unit[18] = {0}, strain[6];
-            unit[a] = 1.0;
-            strain_from_gradients(cache + 18 * g, unit, strain);
+            /* the strain of a unit displacement a = 3 n + i (strain_from_gradients of a unit vector):
+             * the gradient's row i is node n's shape-function gradient */
+            double g3[3][3] = {{0}}, strain[6];
+            for (int j = 0; j < 3; j++)
+                g3[a % 3][j] = dndx[3 * (a / 3) + j];
+            strain[0] = g3[0][0];
+            strain[1] = g3[1][1];
+            strain[2] = g3[2][2];
+            strain[3] = g3[0][1] + g3[1][0];
+            strain[4] = g3[1][2] + g3[2][1];
+            strain[5] = g3[2][0] + g3[0][2];
             for (int i = 0; i < 6; i++) {
                 double s = 0.0;
                 for (int j = 0; j < 6; j++)
@@ -297,7 +307,10 @@ static void heap_down(bound_entry *h, int32_t n, int32_t i)
  * most LAZY_LEVEL: that sum bounds the exact ratio too. After a removal the displacements change
  * little away from the crack tip (within a few layer thicknesses), so most elements are skipped. Every
  * element that could be over 1 or tie with a maximum over 1 still gets its full bound, so the
- * candidates, the exact ratios and the decisions are the same as without. */
+ * candidates, the exact ratios and the decisions are the same as without. The bounds of a long list
+ * (a whole layer's, a large relaxation's) are evaluated on several threads in fixed parts
+ * (fs_parallel_ranges), each element writing only its own slots; the nodal ratios its corners share
+ * are marked stale afterwards on the calling thread, so the results do not depend on the threads. */
 /* The corners of element e need their nodal ratios recomputed. */
 static void touch_nodes(fs_wedge_model *w, int32_t e)
 {
@@ -305,22 +318,22 @@ static void touch_nodes(fs_wedge_model *w, int32_t e)
         w->node_ratio[w->mesh->tri[3 * (size_t)e + c]] = NAN;
 }
 
-int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_elems)
+/* The listed elements' ratio bounds (fs_wedge_element_ratios) on one thread. */
+typedef struct {
+    fs_wedge_model *w;
+    const int32_t *elems;
+    uint8_t *touched; /* per listed element: 1 if its corners' nodal ratios need recomputing */
+} ratio_pass;
+
+static void ratio_range(void *ctx, int32_t q0, int32_t q1)
 {
-    double t0 = fs_seconds();
-    int32_t n_over = 0;
-    double coef[FS_WEDGE_PATTERNS];
-    fs_wedge_load_coefficients(w, coef);
-    if (memcmp(coef, w->ratio_ref_coef, sizeof coef) != 0) {
-        for (int32_t e = 0; e < w->n_elems; e++)
-            w->ratio_ref_bound[e] = NAN;
-        memcpy(w->ratio_ref_coef, coef, sizeof coef);
-    }
-    for (int32_t q = 0; q < n_elems; q++) {
-        int32_t e = elems ? elems[q] : q;
+    const ratio_pass *c = ctx;
+    fs_wedge_model *w = c->w;
+    for (int32_t q = q0; q < q1; q++) {
+        int32_t e = c->elems ? c->elems[q] : q;
+        c->touched[q] = 1;
         if (w->state[e] != FS_WEDGE_ALIVE) {
             w->ratio[e] = NAN;
-            touch_nodes(w, e);
             continue;
         }
         double ue[18];
@@ -334,25 +347,48 @@ int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_e
             double lazy = ref + w->ratio_lipschitz[e] * sqrt(d2) + LAZY_MARGIN * fabs(ref);
             if (lazy <= LAZY_LEVEL) {
                 w->ratio[e] = lazy;
+                c->touched[q] = 0;
                 continue;
             }
         }
-        const double *c = w->gauss_cache + FS_WEDGE_GAUSS_CACHE * (size_t)e;
+        const double *gc = w->gauss_cache + FS_WEDGE_GAUSS_CACHE * (size_t)e;
         double *st = w->stress_top + 18 * (size_t)e, bound = -INFINITY;
         for (int g = 0; g < FS_WEDGE_GAUSS_TOP; g++) {
             double strain[6];
-            strain_from_gradients(c + 18 * g, ue, strain);
+            strain_from_gradients(gc + 18 * g, ue, strain);
             for (int k = 0; k < 3; k++)
                 for (int v = 0; v < 6; v++)
-                    strain[v] -= w->shrink_coef[k] * c[54 + 18 * g + 6 * k + v];
+                    strain[v] -= w->shrink_coef[k] * gc[54 + 18 * g + 6 * k + v];
             stress_of(w, e, strain, st + 6 * g);
             bound = fmax(bound, fs_eigen_principal_bound(st + 6 * g, w->threshold[e]));
         }
         w->ratio[e] = bound / w->threshold[e];
         w->ratio_ref_bound[e] = w->ratio[e];
-        touch_nodes(w, e);
         memcpy(ref_u, ue, sizeof ue);
     }
+}
+
+/* Fewer listed elements than this are evaluated on the calling thread. */
+#define RATIO_PARALLEL_MIN 2048
+
+int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_elems)
+{
+    double t0 = fs_seconds();
+    int32_t n_over = 0;
+    double coef[FS_WEDGE_PATTERNS];
+    fs_wedge_load_coefficients(w, coef);
+    if (memcmp(coef, w->ratio_ref_coef, sizeof coef) != 0) {
+        for (int32_t e = 0; e < w->n_elems; e++)
+            w->ratio_ref_bound[e] = NAN;
+        memcpy(w->ratio_ref_coef, coef, sizeof coef);
+    }
+    /* each element writes only its own slots; the nodal ratios its corners share are marked after */
+    ratio_pass pass = {w, elems, fs_malloc((size_t)n_elems + 1)};
+    fs_parallel_ranges(n_elems, RATIO_PARALLEL_MIN, ratio_range, &pass);
+    for (int32_t q = 0; q < n_elems; q++)
+        if (pass.touched[q])
+            touch_nodes(w, elems ? elems[q] : q);
+    free(pass.touched);
     for (int32_t e = 0; e < w->n_elems; e++)
         n_over += w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0;
     if (n_over > 0) {

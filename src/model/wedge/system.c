@@ -11,6 +11,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "base/sort.h"
+#include "base/threads.h"
 #include "model/wedge/element.h"
 
 /* ---- DOFs and node -> element lists ---- */
@@ -605,6 +606,33 @@ int fs_wedge_readd(fs_wedge_model *w, const int32_t *elems, int32_t n, const uin
     return 0;
 }
 
+/* design: a layer that thickens is refilled at every equilibrium at a new thickness, every element
+ * anew. Its element systems and Gauss caches (each element writing only its own slots, its stiffness
+ * parts included) are computed on several threads, REFILL_CHUNK elements at a time into a buffer,
+ * and added into the pattern on the calling thread in element order: the values are those of one
+ * loop, whatever the threads. */
+#define REFILL_CHUNK 4096
+
+typedef struct {
+    fs_wedge_model *w;
+    int32_t e0;
+    double *k;                                /* REFILL_CHUNK stiffness matrices */
+    double (*loads)[FS_WEDGE_PATTERNS][18];   /* and their loads */
+    uint8_t *failed;                          /* per element of the chunk: its system or cache failed */
+} refill_chunk;
+
+static void refill_range(void *ctx, int32_t i0, int32_t i1)
+{
+    const refill_chunk *c = ctx;
+    for (int32_t i = i0; i < i1; i++) {
+        int32_t e = c->e0 + i;
+        c->failed[i] = c->w->state[e] == FS_WEDGE_ALIVE &&
+                       (fs_wedge_element_system(c->w, e, c->w->assembled_thickness, c->k + 324 * (size_t)i,
+                                                c->loads[i]) < 0 ||
+                        fs_wedge_refresh_cache(c->w, &e, 1) < 0);
+    }
+}
+
 /* New values on the same pattern (a changed thickness): zero, re-add every living element in order,
  * so the values are those a fresh assembly gives, and re-factorize without a new analysis. */
 int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
@@ -615,7 +643,30 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
     for (size_t p = 0; p < w->k_fb.used; p++)
         w->k_fb.value[p] = 0.0;
     memset(w->load, 0, (size_t)FS_WEDGE_PATTERNS * w->n_free * sizeof *w->load);
-    if (fs_wedge_readd(w, NULL, w->n_elems, NULL) < 0 || fs_wedge_refresh_cache(w, NULL, w->n_elems) < 0)
+    int32_t chunk = w->n_elems < REFILL_CHUNK ? w->n_elems : REFILL_CHUNK;
+    refill_chunk c = {w, 0, fs_malloc((324 * (size_t)chunk + 1) * sizeof *c.k),
+                      fs_malloc(((size_t)chunk + 1) * sizeof *c.loads), fs_malloc((size_t)chunk + 1)};
+    refill_ctx r = {w, NULL};
+    int rc = 0;
+    for (; c.e0 < w->n_elems && rc == 0; c.e0 += chunk) {
+        int32_t n = w->n_elems - c.e0 < chunk ? w->n_elems - c.e0 : chunk;
+        fs_parallel_ranges(n, 256, refill_range, &c);
+        for (int32_t i = 0; i < n && rc == 0; i++) {
+            int32_t e = c.e0 + i;
+            if (c.failed[i]) { /* again on this thread, for its message */
+                double k[324], loads[FS_WEDGE_PATTERNS][18];
+                rc = fs_wedge_element_system(w, e, base_thickness, k, loads) < 0 ? -1 : fs_wedge_refresh_cache(w, &e, 1);
+                FS_ASSERT(rc < 0);
+            } else if (w->state[e] == FS_WEDGE_ALIVE) {
+                element_pairs(w, e, c.k + 324 * (size_t)i, add_in_place, &r);
+                add_loads(w, e, c.loads[i], NULL);
+            }
+        }
+    }
+    free(c.k);
+    free(c.loads);
+    free(c.failed);
+    if (rc < 0)
         return -1;
     fix_orphans(w);
     w->counters.assemble_seconds += fs_seconds() - t0;
