@@ -331,6 +331,28 @@ static void test_extended_matrix_is_fresh(void)
     fs_mesh_free(&m);
 }
 
+/* A thickening layer is refilled at each new thickness through the pattern slots it keeps between
+ * cuts (system.c): after cuts and refills in turn, and one more refill after the last cut, its system
+ * is still a fresh assembly's. */
+static void test_refilled_matrix_is_fresh(void)
+{
+    fs_config cfg = wedge_strip_config();
+    cfg.domain.periodic_x = cfg.domain.periodic_y = false;
+    cfg.material.thickness_final = 0.4;
+    fs_mesh m = {0};
+    CHECK(wedge_test_mesh(&cfg, 600, &m) == 0);
+    fs_wedge_model w;
+    CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
+    CHECK(fs_wedge_simulate(&w, 0.8) == 0);
+    CHECK_MSG(w.fractures >= 10, "%lld splits", (long long)w.fractures);
+    uint64_t version = w.pattern_version;
+    CHECK(fs_wedge_equilibrium(&w, 0.9) == 0);
+    CHECK(w.refill_slot_version == version && w.assembled_thickness > 0.2);
+    check_system_is_fresh(&w);
+    fs_wedge_free(&w);
+    fs_mesh_free(&m);
+}
+
 /* Twice the signed area of the triangle of nodes a, b, c (the plane: z ignored). */
 static double orientation(const fs_mesh *m, int32_t a, int32_t b, int32_t c)
 {
@@ -412,6 +434,7 @@ int main(void)
     RUN(test_crack_perpendicular);
     RUN(test_griffith);
     RUN(test_extended_matrix_is_fresh);
+    RUN(test_refilled_matrix_is_fresh);
     RUN(test_flip_extends_old_columns);
     return check_finish();
 }

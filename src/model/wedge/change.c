@@ -255,6 +255,7 @@ static int extend_system(fs_wedge_model *w, int32_t n_free_old, int32_t n_fixed_
 {
     int32_t nf = w->n_free;
     FS_ASSERT(nf >= n_free_old && w->n_fixed >= n_fixed_old && w->k_fb.n == n_fixed_old);
+    w->pattern_version++;
     fs_sparse_matrix *k = &w->k_free;
     fs_wedge_coupling *c = &w->k_fb;
     fs_wedge_coupling_resize(c, w->n_fixed);

@@ -47,6 +47,9 @@
 /* Unit load patterns per element: three of shrinkage, three of eigenstrain (see wedge.c). */
 #define FS_WEDGE_PATTERNS 6
 
+/* Pairs (a <= c) of an element's 18 DOFs. */
+#define FS_WEDGE_PAIRS 171
+
 /* Inputs of an element's stiffness parts (k_parts): its corners' x and y, their thickness factors,
  * its Young's modulus. */
 #define FS_WEDGE_K_KEY 10
@@ -142,6 +145,11 @@ struct fs_wedge_model {
     double *k_parts;             /* per element, 3 x 324, with k_parts_on (else NULL): K1, K0, K2 of its stiffness
                                     h K1 + K0 + K2 / h at base thickness h (fs_wedge_element_system) */
     double *k_key;               /* per element, FS_WEDGE_K_KEY: the inputs k_parts were fitted to */
+    int32_t *refill_slot;        /* per element, FS_WEDGE_PAIRS, for fs_wedge_refill_system: where each
+                                    kept pair of its DOFs lies (system.c) */
+    int32_t refill_slot_elems;   /* elements refill_slot has room for */
+    uint64_t pattern_version;    /* bumped whenever the DOF numbering or the system's pattern changes */
+    uint64_t refill_slot_version; /* the pattern_version refill_slot was made for (0: none) */
     double *threshold;           /* per element: threshold stress (MPa), with the map and jitter */
     double *ratio;               /* per element, at the current equilibrium: the largest principal
                                     stress at the three top Gauss points over the threshold, or an

@@ -42,6 +42,7 @@ void fs_wedge_number_dofs(fs_wedge_model *w)
             }
         }
     w->n_fixed = next - w->n_free;
+    w->pattern_version++;
 }
 
 /* Room each node's element list gets beyond its entries, so that cuts update it in place. */
@@ -610,27 +611,70 @@ int fs_wedge_readd(fs_wedge_model *w, const int32_t *elems, int32_t n, const uin
  * anew. Its element systems and Gauss caches (each element writing only its own slots, its stiffness
  * parts included) are computed on several threads, REFILL_CHUNK elements at a time into a buffer,
  * and added into the pattern on the calling thread in element order: the values are those of one
- * loop, whatever the threads. */
+ * loop, whatever the threads. Where each pair of an element's DOFs lies in the pattern is looked up
+ * once per pattern (on the threads too) and kept in refill_slot: the event search refills the same
+ * pattern at several thicknesses between cuts. */
 #define REFILL_CHUNK 4096
+
+/* refill_slot entries: a slot of k_free (>= 0), of k_fb (-2 - slot), or a fixed-fixed pair left out */
+#define SLOT_NONE (-1)
 
 typedef struct {
     fs_wedge_model *w;
     int32_t e0;
-    double *k;                                /* REFILL_CHUNK stiffness matrices */
-    double (*loads)[FS_WEDGE_PATTERNS][18];   /* and their loads */
-    uint8_t *failed;                          /* per element of the chunk: its system or cache failed */
+    bool slots;                             /* look the slots up too */
+    double *k;                              /* REFILL_CHUNK stiffness matrices */
+    double (*loads)[FS_WEDGE_PATTERNS][18]; /* and their loads */
+    uint8_t *failed;                        /* per element of the chunk: its system or cache failed */
 } refill_chunk;
+
+static void element_slots(const fs_wedge_model *w, int32_t e, int32_t *slot)
+{
+    int32_t g[18];
+    for (int a = 0; a < 18; a++)
+        g[a] = fs_wedge_elem_dof(w, e, a);
+    for (int a = 0, q = 0; a < 18; a++)
+        for (int c = a; c < 18; c++, q++) {
+            bool in_fb;
+            int32_t p = g[a] >= w->n_free && g[c] >= w->n_free ? SLOT_NONE : system_slot(w, g[a], g[c], &in_fb);
+            FS_ASSERT(p != -1 || (g[a] >= w->n_free && g[c] >= w->n_free));
+            slot[q] = p >= 0 && in_fb ? -2 - p : p;
+        }
+}
 
 static void refill_range(void *ctx, int32_t i0, int32_t i1)
 {
     const refill_chunk *c = ctx;
+    fs_wedge_model *w = c->w;
     for (int32_t i = i0; i < i1; i++) {
         int32_t e = c->e0 + i;
-        c->failed[i] = c->w->state[e] == FS_WEDGE_ALIVE &&
-                       (fs_wedge_element_system(c->w, e, c->w->assembled_thickness, c->k + 324 * (size_t)i,
-                                                c->loads[i]) < 0 ||
-                        fs_wedge_refresh_cache(c->w, &e, 1) < 0);
+        c->failed[i] = w->state[e] == FS_WEDGE_ALIVE &&
+                       (fs_wedge_element_system(w, e, w->assembled_thickness, c->k + 324 * (size_t)i, c->loads[i]) < 0 ||
+                        fs_wedge_refresh_cache(w, &e, 1) < 0);
+        if (c->slots && w->state[e] == FS_WEDGE_ALIVE)
+            element_slots(w, e, w->refill_slot + FS_WEDGE_PAIRS * (size_t)e);
     }
+}
+
+/* Adds element e's stiffness K at its kept slots (element_pairs' values, in its order). */
+static void add_at_slots(fs_wedge_model *w, int32_t e, const double K[324])
+{
+    const int32_t *slot = w->refill_slot + FS_WEDGE_PAIRS * (size_t)e;
+    int32_t g[18];
+    for (int a = 0; a < 18; a++)
+        g[a] = fs_wedge_elem_dof(w, e, a);
+    for (int a = 0, q = 0; a < 18; a++)
+        for (int c = a; c < 18; c++, q++) {
+            if (slot[q] == SLOT_NONE)
+                continue;
+            double v = K[18 * a + c];
+            if (c != a && g[a] == g[c])
+                v *= 2.0;
+            if (slot[q] >= 0)
+                w->k_free.values[slot[q]] += v;
+            else
+                w->k_fb.value[-2 - slot[q]] += v;
+        }
 }
 
 /* New values on the same pattern (a changed thickness): zero, re-add every living element in order,
@@ -644,9 +688,14 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
         w->k_fb.value[p] = 0.0;
     memset(w->load, 0, (size_t)FS_WEDGE_PATTERNS * w->n_free * sizeof *w->load);
     int32_t chunk = w->n_elems < REFILL_CHUNK ? w->n_elems : REFILL_CHUNK;
-    refill_chunk c = {w, 0, fs_malloc((324 * (size_t)chunk + 1) * sizeof *c.k),
-                      fs_malloc(((size_t)chunk + 1) * sizeof *c.loads), fs_malloc((size_t)chunk + 1)};
-    refill_ctx r = {w, NULL};
+    refill_chunk c = {w, 0, w->refill_slot_version != w->pattern_version || w->refill_slot_elems < w->n_elems,
+                      fs_malloc((324 * (size_t)chunk + 1) * sizeof *c.k), fs_malloc(((size_t)chunk + 1) * sizeof *c.loads),
+                      fs_malloc((size_t)chunk + 1)};
+    if (c.slots && w->refill_slot_elems < w->n_elems) {
+        w->refill_slot_elems = w->n_elems + w->n_elems / 4;
+        free(w->refill_slot);
+        w->refill_slot = fs_malloc(FS_WEDGE_PAIRS * (size_t)w->refill_slot_elems * sizeof *w->refill_slot);
+    }
     int rc = 0;
     for (; c.e0 < w->n_elems && rc == 0; c.e0 += chunk) {
         int32_t n = w->n_elems - c.e0 < chunk ? w->n_elems - c.e0 : chunk;
@@ -658,7 +707,7 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
                 rc = fs_wedge_element_system(w, e, base_thickness, k, loads) < 0 ? -1 : fs_wedge_refresh_cache(w, &e, 1);
                 FS_ASSERT(rc < 0);
             } else if (w->state[e] == FS_WEDGE_ALIVE) {
-                element_pairs(w, e, c.k + 324 * (size_t)i, add_in_place, &r);
+                add_at_slots(w, e, c.k + 324 * (size_t)i);
                 add_loads(w, e, c.loads[i], NULL);
             }
         }
@@ -666,6 +715,8 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
     free(c.k);
     free(c.loads);
     free(c.failed);
+    /* a failure leaves slots unset: looked up again next time */
+    w->refill_slot_version = rc == 0 ? w->pattern_version : 0;
     if (rc < 0)
         return -1;
     fix_orphans(w);

@@ -280,6 +280,7 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->young);
     free(w->k_parts);
     free(w->k_key);
+    free(w->refill_slot);
     free(w->threshold);
     free(w->ratio);
     free(w->stress_top);
