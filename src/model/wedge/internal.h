@@ -142,8 +142,9 @@ struct fs_wedge_model {
     uint8_t *state;              /* fs_wedge_state per element */
     double *young;               /* per element: Young's modulus (MPa), with the map */
     bool k_parts_on;             /* the layer's thickness changes in time on a flat frame */
-    double *k_parts;             /* per element, 3 x 324, with k_parts_on (else NULL): K1, K0, K2 of its stiffness
-                                    h K1 + K0 + K2 / h at base thickness h (fs_wedge_element_system) */
+    double *k_parts;             /* per element, 3 x FS_WEDGE_PAIRS, with k_parts_on (else NULL): the upper
+                                    triangles (row by row) of K1, K0, K2 of its stiffness h K1 + K0 + K2 / h
+                                    at base thickness h (fs_wedge_element_system) */
     double *k_key;               /* per element, FS_WEDGE_K_KEY: the inputs k_parts were fitted to */
     int32_t *refill_slot;        /* per element, FS_WEDGE_PAIRS, for fs_wedge_refill_system: where each
                                     kept pair of its DOFs lies (system.c) */

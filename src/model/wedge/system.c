@@ -198,7 +198,7 @@ static int element_stiffness(const fs_wedge_model *w, int32_t e, double h, const
         key[6 + c] = w->thickness_factor[w->mesh->tri[3 * (size_t)e + c]];
     }
     key[9] = w->young[e];
-    double *parts = w->k_parts + 3 * 324 * (size_t)e, *kept = w->k_key + FS_WEDGE_K_KEY * (size_t)e;
+    double *parts = w->k_parts + 3 * FS_WEDGE_PAIRS * (size_t)e, *kept = w->k_key + FS_WEDGE_K_KEY * (size_t)e;
     if (memcmp(key, kept, sizeof key) != 0) { /* new inputs: integrate, fit next time */
         memcpy(kept, key, sizeof key);
         parts[0] = NAN;
@@ -219,12 +219,19 @@ static int element_stiffness(const fs_wedge_model *w, int32_t e, double h, const
         }
         double row_scale[3] = {1.0 / (3.0 * h), 1.0 / 3.0, h / 3.0};
         for (int j = 0; j < 3; j++)
-            for (int p = 0; p < 324; p++)
-                parts[324 * j + p] = row_scale[j] * (inv[j][0] * ka[0][p] + inv[j][1] * ka[1][p] + inv[j][2] * ka[2][p]);
+            for (int a = 0, q = 0; a < 18; a++)
+                for (int c = a; c < 18; c++, q++) {
+                    int p = 18 * a + c;
+                    parts[FS_WEDGE_PAIRS * j + q] =
+                        row_scale[j] * (inv[j][0] * ka[0][p] + inv[j][1] * ka[1][p] + inv[j][2] * ka[2][p]);
+                }
         free(ka);
     }
-    for (int p = 0; p < 324; p++)
-        K[p] = h * parts[p] + parts[324 + p] + parts[648 + p] / h;
+    /* the parts are symmetric (the quadrature's stiffness is, entry for entry): their upper triangles */
+    for (int a = 0, q = 0; a < 18; a++)
+        for (int c = a; c < 18; c++, q++)
+            K[18 * a + c] = K[18 * c + a] =
+                h * parts[q] + parts[FS_WEDGE_PAIRS + q] + parts[2 * FS_WEDGE_PAIRS + q] / h;
     return 0;
 }
 

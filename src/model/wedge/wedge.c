@@ -172,7 +172,7 @@ void fs_wedge_grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
     w->state = fs_realloc(w->state, ne * sizeof *w->state);
     w->young = fs_realloc(w->young, ne * sizeof *w->young);
     if (w->k_parts_on) {
-        w->k_parts = fs_realloc(w->k_parts, 3 * 324 * ne * sizeof *w->k_parts);
+        w->k_parts = fs_realloc(w->k_parts, 3 * FS_WEDGE_PAIRS * ne * sizeof *w->k_parts);
         w->k_key = fs_realloc(w->k_key, FS_WEDGE_K_KEY * ne * sizeof *w->k_key);
         for (size_t q = FS_WEDGE_K_KEY * (size_t)w->n_elems; q < FS_WEDGE_K_KEY * ne; q++)
             w->k_key[q] = NAN;
