@@ -10,6 +10,7 @@
 #include "base/rng.h"
 #include "check.h"
 #include "solve/cg.h"
+#include "solve/node_order.h"
 #include "solve/sparse.h"
 
 static const double pi = 3.14159265358979323846;
@@ -418,6 +419,119 @@ static void test_cholesky_solves_poisson(void)
     free(x);
     free(x1);
     fs_sparse_matrix_free(&a);
+}
+
+
+/* A graph for the kept order's test: nodes with up to 8 neighbours each. */
+typedef struct {
+    int32_t n, nb[2000][8], count[2000];
+} graph;
+
+static void graph_link(graph *g, int32_t a, int32_t b)
+{
+    g->nb[a][g->count[a]++] = b;
+    g->nb[b][g->count[b]++] = a;
+}
+
+static int32_t graph_neighbours(void *ctx, int32_t i, int32_t *out, int32_t cap)
+{
+    const graph *g = ctx;
+    for (int32_t k = 0; k < g->count[i] && k < cap; k++)
+        out[k] = g->nb[i][k];
+    return g->count[i];
+}
+
+/* The graph's Laplacian plus 4 on the diagonal (positive definite), one unknown a node. */
+static void graph_matrix(const graph *g, fs_sparse_matrix *a)
+{
+    fs_sparse_builder b;
+    fs_sparse_builder_init(&b, g->n, 0);
+    for (int32_t i = 0; i < g->n; i++) {
+        fs_sparse_builder_add(&b, i, i, 4.0 + g->count[i]);
+        for (int32_t k = 0; k < g->count[i]; k++)
+            if (g->nb[i][k] > i)
+                fs_sparse_builder_add(&b, i, g->nb[i][k], -1.0);
+    }
+    CHECK(fs_sparse_builder_compress(&b, a, NULL) == 0);
+    fs_sparse_builder_free(&b);
+}
+
+/* The order kept across cuts (solve/node_order.h): ordered afresh the first time; after a cut
+ * (a column of nodes duplicated, the copies taking over their links to the right, and one node with
+ * no origin) analysed in the kept order, each copy at its origin's place and the orphan after its
+ * last neighbour, solving as well; ordered afresh again when the kept order has been spoilt. */
+static void test_node_order_kept_across_cuts(void)
+{
+    enum { m = 40, nn = m * m };
+    graph *g = calloc(1, sizeof *g);
+    g->n = nn;
+    for (int32_t y = 0; y < m; y++)
+        for (int32_t x = 0; x < m; x++) {
+            if (x + 1 < m)
+                graph_link(g, y * m + x, y * m + x + 1);
+            if (y + 1 < m)
+                graph_link(g, y * m + x, (y + 1) * m + x);
+        }
+    int32_t dof[2000], origin[2000];
+    for (int32_t i = 0; i < 2000; i++)
+        dof[i] = origin[i] = i;
+    fs_node_order o = {0};
+    fs_sparse_matrix a;
+    graph_matrix(g, &a);
+    fs_node_dofs dofs = {dof, 1, 0, 1, nn};
+    bool fresh = false;
+    fs_cholesky *c = fs_node_order_analyze(&o, &a, nn, &dofs, origin, graph_neighbours, g, &fresh);
+    CHECK(c != NULL && fresh && o.n_nodes == nn && o.flops == fs_cholesky_get_info(c).flops);
+    fs_cholesky_free(c);
+    fs_sparse_matrix_free(&a);
+
+    /* the cut between columns 20 and 21: the copies of column 20 link to column 21 and to each other */
+    for (int32_t y = 0; y < m; y++) {
+        int32_t old = y * m + 20, right = old + 1, copy = nn + y;
+        for (int32_t k = 0; k < g->count[old]; k++)
+            if (g->nb[old][k] == right)
+                g->nb[old][k] = g->nb[old][--g->count[old]];
+        for (int32_t k = 0; k < g->count[right]; k++)
+            if (g->nb[right][k] == old)
+                g->nb[right][k] = g->nb[right][--g->count[right]];
+        graph_link(g, copy, right);
+        if (y > 0)
+            graph_link(g, copy, copy - 1);
+        origin[copy] = old;
+    }
+    int32_t orphan = nn + m;
+    graph_link(g, orphan, 5);
+    graph_link(g, orphan, 700);
+    origin[orphan] = -1;
+    g->n = nn + m + 1;
+    graph_matrix(g, &a);
+    dofs.n = g->n;
+    int32_t rank5 = o.rank[5], rank700 = o.rank[700];
+    c = fs_node_order_analyze(&o, &a, g->n, &dofs, origin, graph_neighbours, g, &fresh);
+    CHECK(c != NULL && !fresh && !strcmp(fs_cholesky_get_info(c).ordering, "given"));
+    CHECK(fs_cholesky_get_info(c).flops <= FS_NODE_REORDER * o.flops);
+    int misplaced = 0;
+    for (int32_t y = 0; y < m; y++)
+        misplaced += o.rank[nn + y] != o.rank[y * m + 20];
+    CHECK_MSG(misplaced == 0, "%d copies away from their origins", misplaced);
+    CHECK(o.rank[orphan] == (rank5 > rank700 ? rank5 : rank700));
+    double *b = random_vector(g->n, 9), *x = malloc((size_t)g->n * sizeof *x);
+    CHECK(fs_cholesky_factorize(c, &a) == 0 && fs_cholesky_solve(c, 1, b, x) == 0);
+    CHECK_MSG(relative_residual(&a, x, b) <= 1e-10, "residual %g", relative_residual(&a, x, b));
+    fs_cholesky_free(c);
+
+    /* a spoilt order (the nodes scattered) fills far more: ordered afresh */
+    for (int32_t i = 0; i < g->n; i++)
+        o.rank[i] = (int32_t)(((int64_t)i * 7919) % g->n);
+    c = fs_node_order_analyze(&o, &a, g->n, &dofs, origin, graph_neighbours, g, &fresh);
+    CHECK(c != NULL && fresh && strcmp(fs_cholesky_get_info(c).ordering, "given") != 0);
+    fs_cholesky_free(c);
+    fs_node_order_free(&o);
+    CHECK(o.rank == NULL);
+    fs_sparse_matrix_free(&a);
+    free(b);
+    free(x);
+    free(g);
 }
 
 /* An analysis in a given order solves as well, reports that order (up to CHOLMOD's postorder, still a
@@ -1180,6 +1294,7 @@ int main(void)
     RUN(test_slots_reproduce_fresh_assembly);
     RUN(test_cholesky_solves_poisson);
     RUN(test_cholesky_given_order);
+    RUN(test_node_order_kept_across_cuts);
     RUN(test_cholesky_solves_elasticity);
     RUN(test_refactorize_scaled_values);
     RUN(test_updown_matches_fresh_factorization);

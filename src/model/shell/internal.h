@@ -9,6 +9,7 @@
 #include "field/growth.h"
 #include "geom/mesh.h"
 #include "model/model.h"
+#include "solve/node_order.h"
 #include "solve/sparse.h"
 
 /* design: the shell is the middle surface of a layer of thickness h, one vertex per mesh node, in 3-D
@@ -196,9 +197,7 @@ struct fs_shell {
     double *work;                  /* scratch: 2 n_free + 6 n_nodes (reallocated to fit) */
     size_t work_size;
     fs_shell_local local;          /* scratch of the local relaxations */
-    int32_t *order_rank;           /* per node: its place in the whole shell's elimination order */
-    int32_t order_nodes;           /* nodes that have a place (the rest came after) */
-    double order_flops;            /* flops of a factorization in the order made afresh last */
+    fs_node_order order;           /* the whole shell's elimination order, kept across cuts */
 
     int64_t fractures;
     fs_shell_counters counters;

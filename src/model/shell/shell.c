@@ -408,7 +408,7 @@ void fs_shell_destroy(fs_shell *s)
     free(s->local.dof);
     free(s->local.in);
     free(s->local.tris);
-    free(s->order_rank);
+    fs_node_order_free(&s->order);
     fs_shell_system_free(&s->sys);
     free(s);
 }

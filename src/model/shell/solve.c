@@ -8,6 +8,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "solve/node_order.h"
 
 /* Newton iterations before giving up, and line-search halvings per iteration. */
 #define MAX_NEWTON 60
@@ -51,113 +52,28 @@ static double force_scale(const fs_shell *s)
 }
 
 /* design: the whole shell's system is re-analysed after every cascade of cuts, a few hundred times a
- * run, and factored only a few times per pattern. METIS's nested dissection fills it least (the
- * 20k-triangle sphere: 5.8 GFlop per factorization against AMD's 10) but its ordering costs some
- * 0.2 s, the symbolic work alone 0.03 s. So METIS orders the shell, each node keeping its place, and
- * the patterns after cuts are analysed in that order: a node a cut made takes the place of the node
- * it was copied from, or else comes right after the last of its neighbours (as a separator's node
- * does; placed with the first, its elimination fills across the separator: three times the flops
- * within 15 cascades). The cuts still make that order fill more (some 3 % a cascade) while a fresh
- * one would fill less (cracks cut the shell apart), so the shell is ordered afresh when an analysis
- * in the kept order costs more than REORDER_FLOPS times the flops of the last fresh one. */
-#define REORDER_FLOPS 1.25
+ * run, and factored only a few times per pattern: it is analysed in an order kept across the cuts
+ * (solve/node_order.h), a node a cut made placed at the node it was duplicated from. */
 
-typedef struct {
-    int32_t rank, node;
-} ranked_node;
-
-static int compare_ranked(const void *a, const void *b)
+/* fs_node_neighbours_fn of the shell: the corners of node i's ring of triangles. */
+static int32_t ring_neighbours(void *ctx, int32_t i, int32_t *out, int32_t cap)
 {
-    const ranked_node *x = a, *y = b;
-    if (x->rank != y->rank)
-        return (x->rank > y->rank) - (x->rank < y->rank);
-    return (x->node > y->node) - (x->node < y->node);
-}
-
-/* Places for the nodes made since the order: the place of the node copied from, else the last of its
- * neighbours' (repeated, for a node whose neighbours are new too), else the end. */
-static void place_new_nodes(fs_shell *s)
-{
-    const fs_mesh *m = s->mesh;
-    int32_t from = s->order_nodes, nn = s->n_nodes;
-    s->order_rank = fs_realloc(s->order_rank, ((size_t)nn + 1) * sizeof *s->order_rank);
-    for (int32_t i = from; i < nn; i++)
-        s->order_rank[i] = s->origin[i] < from ? s->order_rank[s->origin[i]] : -1;
-    for (bool again = true; again;) {
-        again = false;
-        bool placed = false;
-        for (int32_t i = from; i < nn; i++) {
-            if (s->order_rank[i] >= 0)
-                continue;
-            int32_t best = -1;
-            for (int32_t k = m->ring_start[i]; k < m->ring_start[i + 1]; k++)
-                for (int c = 0; c < 3; c++) {
-                    int32_t r = s->order_rank[m->tri[3 * (size_t)m->ring_tri[k] + c]];
-                    if (r >= 0 && r != INT32_MAX && (best < 0 || r > best))
-                        best = r;
-                }
-            if (best >= 0) {
-                s->order_rank[i] = best;
-                placed = true;
-            } else {
-                again = true;
-            }
-        }
-        if (again && !placed) {
-            for (int32_t i = from; i < nn; i++)
-                if (s->order_rank[i] < 0)
-                    s->order_rank[i] = INT32_MAX;
-            again = false;
-        }
-    }
-    s->order_nodes = nn;
+    const fs_mesh *m = ctx;
+    int32_t n = 0;
+    for (int32_t k = m->ring_start[i]; k < m->ring_start[i + 1]; k++)
+        for (int c = 0; c < 3; c++, n++)
+            if (n < cap)
+                out[n] = m->tri[3 * (size_t)m->ring_tri[k] + c];
+    return n;
 }
 
 static fs_cholesky *analyze_whole(fs_shell *s, fs_shell_system *sys)
 {
-    int32_t nf = sys->n_free, nn = s->n_nodes;
-    if (s->order_rank) {
-        place_new_nodes(s);
-        ranked_node *order = fs_malloc(((size_t)nn + 1) * sizeof *order);
-        for (int32_t i = 0; i < nn; i++)
-            order[i] = (ranked_node){s->order_rank[i], i};
-        qsort(order, (size_t)nn, sizeof *order, compare_ranked);
-        int32_t *perm = fs_malloc(((size_t)nf + 1) * sizeof *perm), p = 0;
-        for (int32_t q = 0; q < nn; q++)
-            for (int k = 0; k < 3; k++) {
-                int32_t d = sys->dof[3 * (size_t)order[q].node + k];
-                if (d >= 0)
-                    perm[p++] = d;
-            }
-        FS_ASSERT(p == nf);
-        fs_cholesky *c = fs_cholesky_analyze_given(&sys->K, perm);
-        free(perm);
-        free(order);
-        if (!c || fs_cholesky_get_info(c).flops <= REORDER_FLOPS * s->order_flops)
-            return c;
-        fs_cholesky_free(c);
-    }
-    fs_cholesky *c = fs_cholesky_analyze(&sys->K);
-    if (!c)
-        return NULL;
-    s->counters.orderings++;
-    /* each node's place: the first of its DOFs in the order */
-    int32_t *node_of = fs_malloc(((size_t)nf + 1) * sizeof *node_of);
-    for (int32_t i = 0; i < nn; i++)
-        for (int k = 0; k < 3; k++) {
-            int32_t d = sys->dof[3 * (size_t)i + k];
-            if (d >= 0)
-                node_of[d] = i;
-        }
-    s->order_rank = fs_realloc(s->order_rank, ((size_t)nn + 1) * sizeof *s->order_rank);
-    for (int32_t i = 0; i < nn; i++)
-        s->order_rank[i] = INT32_MAX;
-    const int32_t *perm = fs_cholesky_permutation(c);
-    for (int32_t k = nf - 1; k >= 0; k--)
-        s->order_rank[node_of[perm[k]]] = k;
-    free(node_of);
-    s->order_nodes = nn;
-    s->order_flops = fs_cholesky_get_info(c).flops;
+    fs_node_dofs dofs = {sys->dof, 3, 0, 3, sys->n_free};
+    bool fresh = false;
+    fs_cholesky *c =
+        fs_node_order_analyze(&s->order, &sys->K, s->n_nodes, &dofs, s->origin, ring_neighbours, s->mesh, &fresh);
+    s->counters.orderings += fresh;
     return c;
 }
 

@@ -522,6 +522,7 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
         double s = c->node_weight[i - n0];
         w->thickness_factor[i] = (1.0 - s) * w->thickness_factor[a] + s * w->thickness_factor[b];
         w->pinned[i] = w->pinned[a];
+        w->origin[i] = s <= 0.5 ? a : b;
         for (int l = 0; l < 6; l++) {
             w->u[6 * (size_t)i + l] = (1.0 - s) * w->u[6 * (size_t)a + l] + s * w->u[6 * (size_t)b + l];
             w->prescribed[6 * (size_t)i + l] =

@@ -9,6 +9,7 @@
 #include "geom/mesh.h"
 #include "geom/surface.h"
 #include "model/model.h"
+#include "solve/node_order.h"
 #include "solve/sparse.h"
 
 /* design: every triangle of the surface mesh is extruded into one wedge (thesis §5.2): its bottom
@@ -128,6 +129,7 @@ struct fs_wedge_model {
     double *normal;              /* 3 per node: unit extrusion direction (flat frames: +z) */
     double *thickness_factor;    /* per node: thickness map and gradient factor (times the thickness at t) */
     uint8_t *pinned;             /* per node: 1 if its top node is prescribed too (patch tests), else 0 */
+    int32_t *origin;             /* per node: the node a cut copied it from (its nearer parent), -1 if none */
     double *prescribed;          /* 6 per node: prescribed displacement of fixed DOFs besides growth (cm) */
     double *u;                   /* 6 per node: displacement at the current equilibrium (cm) */
     int32_t *node_elem_start;    /* per node: where its list of the elements using it (ascending,
@@ -197,6 +199,7 @@ struct fs_wedge_model {
     uint8_t *mark;               /* n_free + n_fixed scratch flags, all 0 between calls */
     double assembled_thickness;  /* base thickness (cm) the system was assembled with */
     fs_cholesky *chol;           /* the factor of k_free (CHOLMOD), NULL with CG */
+    fs_node_order order;         /* the elimination order kept across cuts (fs_wedge_factorize) */
     int32_t updowns_pending;     /* rank updates applied since the last numeric factorization */
     bool factor_stale;           /* k_free changed since chol was computed (local relaxation defers
                                     the update); the next global solve re-factorizes first */

@@ -490,6 +490,21 @@ static void fix_orphans(fs_wedge_model *w)
     }
 }
 
+/* fs_node_neighbours_fn of the wedge model: the corners of node i's elements, dead ones too. */
+static int32_t element_neighbours(void *ctx, int32_t i, int32_t *out, int32_t cap)
+{
+    const fs_wedge_model *w = ctx;
+    int32_t n = 0;
+    for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++)
+        for (int c = 0; c < 3; c++, n++)
+            if (n < cap)
+                out[n] = w->mesh->tri[3 * (size_t)w->node_elem[p] + c];
+    return n;
+}
+
+/* design: the pattern changes with every cascade of cuts, and each change needs a new analysis: it is
+ * made in the order kept across the cuts (solve/node_order.h), a node a cut made placed at its nearer
+ * parent. */
 int fs_wedge_factorize(fs_wedge_model *w, bool analyze)
 {
 #ifdef FS_VALIDATE
@@ -500,7 +515,9 @@ int fs_wedge_factorize(fs_wedge_model *w, bool analyze)
     double t0 = fs_seconds();
     if (analyze || !w->chol) {
         fs_cholesky_free(w->chol);
-        w->chol = fs_cholesky_analyze(&w->k_free);
+        fs_node_dofs dofs = {w->dof, 6, 3, 3, w->n_free};
+        w->chol = fs_node_order_analyze(&w->order, &w->k_free, w->n_nodes, &dofs, w->origin, element_neighbours, w,
+                                        NULL);
         if (!w->chol)
             return -1;
         w->counters.analyses++;

@@ -160,11 +160,13 @@ void fs_wedge_grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
     w->normal = fs_realloc(w->normal, 3 * nn * sizeof *w->normal);
     w->thickness_factor = fs_realloc(w->thickness_factor, nn * sizeof *w->thickness_factor);
     w->pinned = fs_realloc(w->pinned, nn * sizeof *w->pinned);
+    w->origin = fs_realloc(w->origin, nn * sizeof *w->origin);
     w->prescribed = fs_realloc(w->prescribed, 6 * nn * sizeof *w->prescribed);
     w->u = fs_realloc(w->u, 6 * nn * sizeof *w->u);
     w->node_elem_count = fs_realloc(w->node_elem_count, nn * sizeof *w->node_elem_count);
     for (size_t i = (size_t)w->n_nodes; i < nn; i++) {
         w->pinned[i] = 0;
+        w->origin[i] = -1;
         memset(w->prescribed + 6 * i, 0, 6 * sizeof *w->prescribed);
         memset(w->u + 6 * i, 0, 6 * sizeof *w->u);
         node_normal(w, (int32_t)i, w->normal + 3 * i);
@@ -274,6 +276,8 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->normal);
     free(w->thickness_factor);
     free(w->pinned);
+    free(w->origin);
+    fs_node_order_free(&w->order);
     free(w->prescribed);
     free(w->u);
     free(w->state);
