@@ -57,4 +57,16 @@ static inline double fs_mat3_inverse(const double *m, double *inv)
     return det;
 }
 
+/* The strain of a displacement gradient g (g[i][j] = d u_i / d x_j) in Voigt order with engineering
+ * shears: xx, yy, zz, xy, yz, zx. */
+static inline void fs_voigt_strain(const double g[3][3], double strain[6])
+{
+    strain[0] = g[0][0];
+    strain[1] = g[1][1];
+    strain[2] = g[2][2];
+    strain[3] = g[0][1] + g[1][0];
+    strain[4] = g[1][2] + g[2][1];
+    strain[5] = g[2][0] + g[0][2];
+}
+
 #endif

@@ -57,12 +57,7 @@ void fs_tet_strain(const double g[12], const double u[12], double strain[6])
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++)
                 d[i][j] += u[3 * c + i] * g[3 * c + j];
-    strain[0] = d[0][0];
-    strain[1] = d[1][1];
-    strain[2] = d[2][2];
-    strain[3] = d[0][1] + d[1][0];
-    strain[4] = d[1][2] + d[2][1];
-    strain[5] = d[2][0] + d[0][2];
+    fs_voigt_strain(d, strain);
 }
 
 void fs_tet_stress(double lambda, double mu, const double strain[6], double stress[6])

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "base/error.h"
+#include "base/vec.h"
 
 /* design: thesis Table 5.1 combines the 3-point Gauss rule through the thickness (zeta = 0,
  * +-sqrt(3/5), weights 8/9, 5/9) with the 3-point interior triangle rule ((2/3, 1/6, 1/6) and
@@ -136,12 +137,7 @@ static void strain_from_gradients(const double dndx[18], const double u[18], dou
         for (int a = 0; a < 3; a++)
             for (int b = 0; b < 3; b++)
                 g[a][b] += u[3 * i + a] * dndx[3 * i + b];
-    e[0] = g[0][0];
-    e[1] = g[1][1];
-    e[2] = g[2][2];
-    e[3] = g[0][1] + g[1][0];
-    e[4] = g[1][2] + g[2][1];
-    e[5] = g[2][0] + g[0][2];
+    fs_voigt_strain(g, e);
 }
 
 static void mat6_vec(const double D[36], const double v[6], double out[6])

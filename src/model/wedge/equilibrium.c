@@ -168,12 +168,7 @@ static void strain_from_gradients(const double dndx[18], const double u[18], dou
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++)
                 g[i][j] += dndx[3 * n + j] * u[3 * n + i];
-    strain[0] = g[0][0];
-    strain[1] = g[1][1];
-    strain[2] = g[2][2];
-    strain[3] = g[0][1] + g[1][0];
-    strain[4] = g[1][2] + g[2][1];
-    strain[5] = g[2][0] + g[0][2];
+    fs_voigt_strain(g, strain);
 }
 
 /* design: a bound of how fast an element's ratio can change with its nodal displacements u_e, for
@@ -194,12 +189,7 @@ static double ratio_lipschitz(const fs_wedge_model *w, int32_t e, const double *
             double g3[3][3] = {{0}}, strain[6];
             for (int j = 0; j < 3; j++)
                 g3[a % 3][j] = dndx[3 * (a / 3) + j];
-            strain[0] = g3[0][0];
-            strain[1] = g3[1][1];
-            strain[2] = g3[2][2];
-            strain[3] = g3[0][1] + g3[1][0];
-            strain[4] = g3[1][2] + g3[2][1];
-            strain[5] = g3[2][0] + g3[0][2];
+            fs_voigt_strain(g3, strain);
             for (int i = 0; i < 6; i++) {
                 double s = 0.0;
                 for (int j = 0; j < 6; j++)
