@@ -523,9 +523,9 @@ int32_t fs_wedge_relax_region(const fs_wedge_model *w, const int32_t *seeds, int
  * displacement at w->time (growth motion included). */
 void fs_wedge_prescribe_fixed(fs_wedge_model *w);
 
-/* Recomputes stress_top and the ratios of the listed elements (all when elems is NULL, n ignored)
- * from w->u, then makes exact every ratio fracture decides on (see the ratio field). Returns 0 or -1
- * with fs_error. */
+/* Recomputes stress_top and the ratios of the listed elements (all when elems is NULL, n ignored;
+ * none listed twice: a long list is split across threads) from w->u, then makes exact every ratio
+ * fracture decides on (see the ratio field). Returns 0 or -1 with fs_error. */
 int fs_wedge_update_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n);
 
 /* ---- --enable-validate (base/error.h: FS_INVARIANT) ---- */
@@ -589,7 +589,8 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness);
 int fs_wedge_factorize(fs_wedge_model *w, bool analyze);
 
 /* equilibrium.c: the element caches of the stress check (gauss_cache, edge_rest) of the listed
- * elements, and their stresses and ratios (see the ratio field). Return 0 or -1 with fs_error. */
+ * elements, and their stresses and ratios (see the ratio field; none listed twice). Return 0 or -1
+ * with fs_error. */
 int fs_wedge_refresh_cache(fs_wedge_model *w, const int32_t *elems, int32_t n);
 int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_elems);
 

@@ -726,11 +726,11 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
         fs_parallel_ranges(n, 256, refill_range, &c);
         for (int32_t i = 0; i < n && rc == 0; i++) {
             int32_t e = c.e0 + i;
-            if (c.failed[i]) { /* again on this thread, for its message */
-                double k[324], loads[FS_WEDGE_PATTERNS][18];
-                rc = fs_wedge_element_system(w, e, base_thickness, k, loads) < 0 ? -1 : fs_wedge_refresh_cache(w, &e, 1);
-                FS_ASSERT(rc < 0);
-            } else if (w->state[e] == FS_WEDGE_ALIVE) {
+            if (c.failed[i]) /* again on this thread, for its message (an error is the thread's own) */
+                rc = fs_wedge_element_system(w, e, base_thickness, c.k + 324 * (size_t)i, c.loads[i]) < 0
+                         ? -1
+                         : fs_wedge_refresh_cache(w, &e, 1);
+            if (rc == 0 && w->state[e] == FS_WEDGE_ALIVE) {
                 add_at_slots(w, e, c.k + 324 * (size_t)i);
                 add_loads(w, e, c.loads[i], NULL);
             }
