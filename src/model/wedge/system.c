@@ -437,28 +437,29 @@ double fs_wedge_system_entry(const fs_wedge_model *w, int32_t g, int32_t j)
     return p < 0 ? 0.0 : in_fb ? w->k_fb.value[p] : w->k_free.values[p];
 }
 
-/* Calls add(ctx, i, j, value) for every kept pair (a <= c) of the element: fixed-fixed pairs are left
- * out; two local DOFs on one global DOF (a node repeated in a tiny periodic mesh) add the
- * off-diagonal term twice, as the full matrix would. */
+/* Calls add(ctx, q, i, j, value) for every kept pair q (a <= c, counted row by row, FS_WEDGE_PAIRS in
+ * all) of the element: fixed-fixed pairs are left out; two local DOFs on one global DOF (a node
+ * repeated in a tiny periodic mesh) add the off-diagonal term twice, as the full matrix would. */
 static void element_pairs(const fs_wedge_model *w, int32_t e, const double K[324],
-                          void (*add)(void *ctx, int32_t i, int32_t j, double v), void *ctx)
+                          void (*add)(void *ctx, int q, int32_t i, int32_t j, double v), void *ctx)
 {
     int32_t g[18];
     for (int a = 0; a < 18; a++)
         g[a] = fs_wedge_elem_dof(w, e, a);
-    for (int a = 0; a < 18; a++)
-        for (int c = a; c < 18; c++) {
+    for (int a = 0, q = 0; a < 18; a++)
+        for (int c = a; c < 18; c++, q++) {
             if (g[a] >= w->n_free && g[c] >= w->n_free)
                 continue;
             double v = K[18 * a + c];
             if (c != a && g[a] == g[c])
                 v *= 2.0;
-            add(ctx, g[a], g[c], v);
+            add(ctx, q, g[a], g[c], v);
         }
 }
 
-static void add_to_builder(void *ctx, int32_t i, int32_t j, double v)
+static void add_to_builder(void *ctx, int q, int32_t i, int32_t j, double v)
 {
+    (void)q;
     fs_sparse_builder_add(ctx, i, j, v);
 }
 
@@ -599,8 +600,9 @@ typedef struct {
     const uint8_t *only; /* if not NULL: add only where both DOFs are marked */
 } refill_ctx;
 
-static void add_in_place(void *ctx, int32_t i, int32_t j, double v)
+static void add_in_place(void *ctx, int q, int32_t i, int32_t j, double v)
 {
+    (void)q;
     refill_ctx *r = ctx;
     if (r->only && !(r->only[i] && r->only[j]))
         return;
@@ -650,20 +652,18 @@ typedef struct {
     double *k;                              /* REFILL_CHUNK stiffness matrices */
     double (*loads)[FS_WEDGE_PATTERNS][18]; /* and their loads */
     uint8_t *failed;                        /* per element of the chunk: its system or cache failed */
+    int32_t *slot;                          /* the current element's refill_slot entries */
 } refill_chunk;
 
-static void element_slots(const fs_wedge_model *w, int32_t e, int32_t *slot)
+/* element_pairs' callback that records where pair q lies (the value is not used). */
+static void record_slot(void *ctx, int q, int32_t i, int32_t j, double v)
 {
-    int32_t g[18];
-    for (int a = 0; a < 18; a++)
-        g[a] = fs_wedge_elem_dof(w, e, a);
-    for (int a = 0, q = 0; a < 18; a++)
-        for (int c = a; c < 18; c++, q++) {
-            bool in_fb;
-            int32_t p = g[a] >= w->n_free && g[c] >= w->n_free ? SLOT_NONE : system_slot(w, g[a], g[c], &in_fb);
-            FS_ASSERT(p != -1 || (g[a] >= w->n_free && g[c] >= w->n_free));
-            slot[q] = p >= 0 && in_fb ? -2 - p : p;
-        }
+    (void)v;
+    const refill_chunk *c = ctx;
+    bool in_fb;
+    int32_t p = system_slot(c->w, i, j, &in_fb);
+    FS_ASSERT(p >= 0);
+    c->slot[q] = in_fb ? -2 - p : p;
 }
 
 static void refill_range(void *ctx, int32_t i0, int32_t i1)
@@ -675,30 +675,27 @@ static void refill_range(void *ctx, int32_t i0, int32_t i1)
         c->failed[i] = w->state[e] == FS_WEDGE_ALIVE &&
                        (fs_wedge_element_system(w, e, w->assembled_thickness, c->k + 324 * (size_t)i, c->loads[i]) < 0 ||
                         fs_wedge_refresh_cache(w, &e, 1) < 0);
-        if (c->slots && w->state[e] == FS_WEDGE_ALIVE)
-            element_slots(w, e, w->refill_slot + FS_WEDGE_PAIRS * (size_t)e);
+        if (c->slots && w->state[e] == FS_WEDGE_ALIVE) {
+            /* each thread its own view of the chunk, pointing at the element's slots */
+            refill_chunk mine = *c;
+            mine.slot = w->refill_slot + FS_WEDGE_PAIRS * (size_t)e;
+            for (int q = 0; q < FS_WEDGE_PAIRS; q++)
+                mine.slot[q] = SLOT_NONE;
+            element_pairs(w, e, c->k + 324 * (size_t)i, record_slot, &mine);
+        }
     }
 }
 
-/* Adds element e's stiffness K at its kept slots (element_pairs' values, in its order). */
-static void add_at_slots(fs_wedge_model *w, int32_t e, const double K[324])
+/* element_pairs' callback that adds pair q's value at its kept slot. */
+static void add_at_slot(void *ctx, int q, int32_t i, int32_t j, double v)
 {
-    const int32_t *slot = w->refill_slot + FS_WEDGE_PAIRS * (size_t)e;
-    int32_t g[18];
-    for (int a = 0; a < 18; a++)
-        g[a] = fs_wedge_elem_dof(w, e, a);
-    for (int a = 0, q = 0; a < 18; a++)
-        for (int c = a; c < 18; c++, q++) {
-            if (slot[q] == SLOT_NONE)
-                continue;
-            double v = K[18 * a + c];
-            if (c != a && g[a] == g[c])
-                v *= 2.0;
-            if (slot[q] >= 0)
-                w->k_free.values[slot[q]] += v;
-            else
-                w->k_fb.value[-2 - slot[q]] += v;
-        }
+    (void)i;
+    (void)j;
+    refill_chunk *c = ctx;
+    if (c->slot[q] >= 0)
+        c->w->k_free.values[c->slot[q]] += v;
+    else
+        c->w->k_fb.value[-2 - c->slot[q]] += v;
 }
 
 /* New values on the same pattern (a changed thickness): zero, re-add every living element in order,
@@ -714,7 +711,7 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
     int32_t chunk = w->n_elems < REFILL_CHUNK ? w->n_elems : REFILL_CHUNK;
     refill_chunk c = {w, 0, w->refill_slot_version != w->pattern_version || w->refill_slot_elems < w->n_elems,
                       fs_malloc((324 * (size_t)chunk + 1) * sizeof *c.k), fs_malloc(((size_t)chunk + 1) * sizeof *c.loads),
-                      fs_malloc((size_t)chunk + 1)};
+                      fs_malloc((size_t)chunk + 1), NULL};
     if (c.slots && w->refill_slot_elems < w->n_elems) {
         w->refill_slot_elems = w->n_elems + w->n_elems / 4;
         free(w->refill_slot);
@@ -731,7 +728,8 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
                          ? -1
                          : fs_wedge_refresh_cache(w, &e, 1);
             if (rc == 0 && w->state[e] == FS_WEDGE_ALIVE) {
-                add_at_slots(w, e, c.k + 324 * (size_t)i);
+                c.slot = w->refill_slot + FS_WEDGE_PAIRS * (size_t)e;
+                element_pairs(w, e, c.k + 324 * (size_t)i, add_at_slot, &c);
                 add_loads(w, e, c.loads[i], NULL);
             }
         }
