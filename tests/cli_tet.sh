@@ -36,10 +36,29 @@ else
     not_ok "mud-thick: halving the thickness gives 2-5x the fragments (got '$f1' -> '$f2')"
 fi
 
+# [render] opening_scale draws the cracks as many times as open as simulated: the same small
+# simulation drawn at 1, 2 and 4 covers (crack mask) about 1, 2 and 4 times as much of the tile
+# (1.5 %, 3.0 % and 6.0 % when this test was written); the crack mask at 1 is what the tet model
+# drew before it read the key.
+STATS="$(dirname "$FISSURE")/tests/crack_stats"
+for sc in 1 2 4; do
+    expect_status 0 "mud-thick drawn at opening_scale $sc" "$FISSURE" -q -o "$tmp/open-$sc" -n x --maps crackmask,cellid \
+        --size 256x256 --set mesh.elements=800 --set render.opening_scale=$sc mud-thick
+    set -- $("$STATS" pieces "$tmp/open-$sc/x_crackmask.png" "$tmp/open-$sc/x_cellid.png" xy)
+    eval "cover$sc=\${4:-}"
+done
+for sc in 2 4; do
+    eval "c=\$cover$sc"
+    if [ -n "$cover1" ] && [ -n "$c" ] && awk_true "$cover1 > 0.005 && $c >= 0.8 * $sc * $cover1 && $c <= 1.2 * $sc * $cover1"; then
+        ok "mud-thick: opening_scale $sc covers $sc times as much ($cover1 -> $c)"
+    else
+        not_ok "mud-thick: opening_scale $sc covers $sc times as much (got '$cover1' -> '$c')"
+    fi
+done
+
 # Bark at its own mesh: the fissures (the crack graph's polylines at least 1 cm from end to end)
 # run within 20 degrees of the trunk's axis for at least 90 % of their length (the texture spans
 # the trunk's 31.4 cm girth across and its 20 cm height up).
-STATS="$(dirname "$FISSURE")/tests/crack_stats"
 expect_status 0 "bark-tet runs" "$FISSURE" -q -o "$tmp/bark" -n x --size 256x256 bark-tet
 n=$(fractures "$tmp/bark/x.json")
 [ "${n:-0}" -gt 20 ] && ok "bark-tet: nodes split ($n)" || not_ok "bark-tet: nodes split (got '$n')"

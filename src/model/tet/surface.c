@@ -61,6 +61,20 @@ static double substrate_radius(const fs_tet *s, const double d[3])
     return 1.0 / sqrt((d[0] * d[0] + d[1] * d[1]) / (a * a) + d[2] * d[2] / (c * c));
 }
 
+/* The displacement of node i as the surface and the pieces draw it (3 values): its part across the
+ * layer (along the layer's normal at the node) as simulated, its part in the layer's plane times
+ * [render] opening_scale, which draws every crack that many times as open as it is (as the wedge
+ * and shell models do). */
+static void drawn_displacement(const fs_tet *s, int32_t i, const double *c, double u[3])
+{
+    double n[3];
+    fs_tet_displacement(s, i, c, u);
+    fs_tet_normal(s, i, n);
+    double un = fs_dot3(u, n), scale = s->cfg.opening_scale;
+    for (int k = 0; k < 3; k++)
+        u[k] = un * n[k] + scale * (u[k] - un * n[k]);
+}
+
 typedef struct {
     fs_surface *out;
     double height[3], crack, cell, shade;
@@ -101,7 +115,7 @@ int fs_tet_surface(const fs_tet *s, fs_surface *out)
         for (int k = 0; k < 3; k++) {
             double u[3];
             fs_tetmesh_corner(m, t, fc[k], p[k]);
-            fs_tet_displacement(s, m->tet[4 * (size_t)t + fc[k]], c, u);
+            drawn_displacement(s, m->tet[4 * (size_t)t + fc[k]], c, u);
             for (int a = 0; a < 3; a++)
                 p[k][a] += u[a];
         }
@@ -258,7 +272,7 @@ int fs_tet_solid(const fs_tet *s, fs_solid *out)
             piece_corner *slot = corner_slot(&tab, comp[t], node, sx, sy);
             if (slot->pos < 0) {
                 double u[3], q[3], w[3];
-                fs_tet_displacement(s, node, c, u);
+                drawn_displacement(s, node, c, u);
                 for (int a = 0; a < 3; a++)
                     q[a] = p[a] + u[a];
                 embed(s, q, w);
