@@ -56,6 +56,12 @@ for sc in 2 4; do
     fi
 done
 
+# mud-thick at its default (opening_scale 4): open gaps over 5-15 % of the tile (8.2 % when this
+# test was written; 2.1 % as simulated).
+set -- $("$STATS" pieces "$tmp/thick/x_crackmask.png" "$tmp/thick/x_cellid.png" xy)
+if [ -n "${4:-}" ] && awk_true "$4 >= 0.05 && $4 <= 0.15"; then ok "mud-thick: its cracks cover $4 of the tile"
+else not_ok "mud-thick: its cracks cover '${4:-}' of the tile, expected 0.05 to 0.15"; fi
+
 # Bark at its own mesh: the fissures (the crack graph's polylines at least 1 cm from end to end)
 # run within 20 degrees of the trunk's axis for at least 90 % of their length (the texture spans
 # the trunk's 31.4 cm girth across and its 20 cm height up).
