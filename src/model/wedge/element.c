@@ -164,30 +164,45 @@ int fs_wedge_volume(const double x[18], double *volume)
     return 0;
 }
 
+/* design: B has three nonzero entries per column: displacement component k of a node enters the strain
+ * rows STRAIN_ROW[k] (ascending) through its shape function's derivative along STRAIN_AXIS[k]. The
+ * products D B and B' (D B) run over those entries only, in the same ascending order as the dense
+ * sums, whose other terms are exact zeros: the stiffness is the dense product's bit for bit, at half
+ * its multiplications. */
+static const int STRAIN_ROW[3][3] = {{0, 3, 5}, {1, 3, 4}, {2, 4, 5}};
+static const int STRAIN_AXIS[3][3] = {{0, 1, 2}, {1, 0, 2}, {2, 1, 0}};
+
 int fs_wedge_stiffness(const double x[18], const double D[36], double K[324])
 {
     double Kup[FS_WEDGE_DOF][FS_WEDGE_DOF] = {{0}};
     for (int g = 0; g < FS_WEDGE_GAUSS; g++) {
         const double *p = fs_wedge_gauss[g];
-        double dndx[18], detj, B[6][18], DB[6][18];
+        double dndx[18], detj, DB[6][FS_WEDGE_DOF], bval[FS_WEDGE_DOF][3];
         if (fs_wedge_gradients(x, p[0], p[1], p[2], dndx, &detj) < 0)
             return -1;
-        strain_matrix(dndx, B);
+        for (int j = 0; j < FS_WEDGE_DOF; j++)
+            for (int t = 0; t < 3; t++)
+                bval[j][t] = dndx[3 * (j / 3) + STRAIN_AXIS[j % 3][t]];
         for (int a = 0; a < 6; a++)
             for (int j = 0; j < FS_WEDGE_DOF; j++) {
+                const int *row = STRAIN_ROW[j % 3];
                 double sum = 0.0;
-                for (int b = 0; b < 6; b++)
-                    sum += D[6 * a + b] * B[b][j];
+                sum += D[6 * a + row[0]] * bval[j][0];
+                sum += D[6 * a + row[1]] * bval[j][1];
+                sum += D[6 * a + row[2]] * bval[j][2];
                 DB[a][j] = sum;
             }
         double wdet = detj * p[3];
-        for (int i = 0; i < FS_WEDGE_DOF; i++)
+        for (int i = 0; i < FS_WEDGE_DOF; i++) {
+            const int *row = STRAIN_ROW[i % 3];
             for (int j = i; j < FS_WEDGE_DOF; j++) {
                 double sum = 0.0;
-                for (int a = 0; a < 6; a++)
-                    sum += B[a][i] * DB[a][j];
+                sum += bval[i][0] * DB[row[0]][j];
+                sum += bval[i][1] * DB[row[1]][j];
+                sum += bval[i][2] * DB[row[2]][j];
                 Kup[i][j] += sum * wdet;
             }
+        }
     }
     for (int i = 0; i < FS_WEDGE_DOF; i++)
         for (int j = i; j < FS_WEDGE_DOF; j++)

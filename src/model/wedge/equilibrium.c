@@ -291,7 +291,9 @@ static void heap_down(bound_entry *h, int32_t n, int32_t i)
  * descending order of the bound, until the next bound falls below the best exact ratio found (less
  * the tie tolerance). Every other ratio holds its bound. Where the layer holds many elements over 1
  * that do not break (Griffith's criterion stops cracks), the candidates come off a binary heap, in
- * the same order as a sort, which would cost n log n at every call for the few that are needed.
+ * the same order as a sort, which would cost n log n at every call for the few that are needed; the
+ * heap holds only the elements whose bound reaches the exact ratio of the first candidate (the
+ * largest bound) less the tie tolerance, as no other could come off it before the search stops.
  * With lazy_ratios, an element evaluated before at the same shrinkage and eigenstrain is not evaluated
  * again while its old bound plus ratio_lipschitz times the change of its nodal displacements stays at
  * most LAZY_LEVEL: that sum bounds the exact ratio too. After a removal the displacements change
@@ -361,10 +363,15 @@ static void ratio_range(void *ctx, int32_t q0, int32_t q1)
 /* Fewer listed elements than this are evaluated on the calling thread. */
 #define RATIO_PARALLEL_MIN 2048
 
+/* Whether living element e's ratio (bound or exact) is over 1. */
+static bool over_one(const fs_wedge_model *w, int32_t e)
+{
+    return w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0;
+}
+
 int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_elems)
 {
     double t0 = fs_seconds();
-    int32_t n_over = 0;
     double coef[FS_WEDGE_PATTERNS];
     fs_wedge_load_coefficients(w, coef);
     if (memcmp(coef, w->ratio_ref_coef, sizeof coef) != 0) {
@@ -379,17 +386,28 @@ int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_e
         if (pass.touched[q])
             touch_nodes(w, elems ? elems[q] : q);
     free(pass.touched);
+    /* the first candidate, then the others that could still be popped: bounds within the tie
+     * tolerance of its exact ratio or over it (best only grows) */
+    bound_entry top = {-INFINITY, -1};
     for (int32_t e = 0; e < w->n_elems; e++)
-        n_over += w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0;
-    if (n_over > 0) {
-        bound_entry *list = fs_malloc((size_t)n_over * sizeof *list);
+        if (over_one(w, e) && (top.e < 0 || bound_before(&(bound_entry){w->ratio[e], e}, &top)))
+            top = (bound_entry){w->ratio[e], e};
+    if (top.e >= 0) {
+        double best = fs_wedge_element_ratio(w, top.e);
+        if (isnan(best))
+            return -1;
+        w->ratio[top.e] = best;
+        double floor = best - 2.0 * FS_RANK_TIE_REL * fabs(best);
         int32_t n = 0;
         for (int32_t e = 0; e < w->n_elems; e++)
-            if (w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0)
+            n += e != top.e && over_one(w, e) && w->ratio[e] >= floor;
+        bound_entry *list = fs_malloc(((size_t)n + 1) * sizeof *list);
+        n = 0;
+        for (int32_t e = 0; e < w->n_elems; e++)
+            if (e != top.e && over_one(w, e) && w->ratio[e] >= floor)
                 list[n++] = (bound_entry){w->ratio[e], e};
         for (int32_t i = n / 2 - 1; i >= 0; i--)
             heap_down(list, n, i);
-        double best = -INFINITY;
         for (int32_t left = n; left > 0;) {
             bound_entry next = list[0];
             if (next.bound < best - 2.0 * FS_RANK_TIE_REL * fabs(best))
