@@ -363,12 +363,6 @@ static void ratio_range(void *ctx, int32_t q0, int32_t q1)
 /* Fewer listed elements than this are evaluated on the calling thread. */
 #define RATIO_PARALLEL_MIN 2048
 
-/* Whether living element e's ratio (bound or exact) is over 1. */
-static bool over_one(const fs_wedge_model *w, int32_t e)
-{
-    return w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0;
-}
-
 int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_elems)
 {
     double t0 = fs_seconds();
@@ -386,26 +380,34 @@ int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_e
         if (pass.touched[q])
             touch_nodes(w, elems ? elems[q] : q);
     free(pass.touched);
-    /* the first candidate, then the others that could still be popped: bounds within the tie
-     * tolerance of its exact ratio or over it (best only grows) */
-    bound_entry top = {-INFINITY, -1};
+    /* the elements over 1 and the first candidate among them; then the heap of those that could
+     * still come off it: bounds within the tie tolerance of its exact ratio or over it (best only
+     * grows) */
+    bound_entry top = {-INFINITY, -1}, *list = NULL;
+    int32_t n = 0, cap = 0;
     for (int32_t e = 0; e < w->n_elems; e++)
-        if (over_one(w, e) && (top.e < 0 || bound_before(&(bound_entry){w->ratio[e], e}, &top)))
-            top = (bound_entry){w->ratio[e], e};
+        if (w->state[e] == FS_WEDGE_ALIVE && w->ratio[e] > 1.0) {
+            if (n == cap) {
+                cap = 2 * cap + 64;
+                list = fs_realloc(list, (size_t)cap * sizeof *list);
+            }
+            list[n++] = (bound_entry){w->ratio[e], e};
+            if (top.e < 0 || bound_before(&list[n - 1], &top))
+                top = list[n - 1];
+        }
     if (top.e >= 0) {
         double best = fs_wedge_element_ratio(w, top.e);
-        if (isnan(best))
+        if (isnan(best)) {
+            free(list);
             return -1;
+        }
         w->ratio[top.e] = best;
-        double floor = best - 2.0 * FS_RANK_TIE_REL * fabs(best);
-        int32_t n = 0;
-        for (int32_t e = 0; e < w->n_elems; e++)
-            n += e != top.e && over_one(w, e) && w->ratio[e] >= floor;
-        bound_entry *list = fs_malloc(((size_t)n + 1) * sizeof *list);
-        n = 0;
-        for (int32_t e = 0; e < w->n_elems; e++)
-            if (e != top.e && over_one(w, e) && w->ratio[e] >= floor)
-                list[n++] = (bound_entry){w->ratio[e], e};
+        double lowest = best - 2.0 * FS_RANK_TIE_REL * fabs(best);
+        int32_t kept = 0;
+        for (int32_t q = 0; q < n; q++)
+            if (list[q].e != top.e && list[q].bound >= lowest)
+                list[kept++] = list[q];
+        n = kept;
         for (int32_t i = n / 2 - 1; i >= 0; i--)
             heap_down(list, n, i);
         for (int32_t left = n; left > 0;) {
