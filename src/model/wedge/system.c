@@ -250,13 +250,21 @@ int fs_wedge_element_system(const fs_wedge_model *w, int32_t e, double base_thic
     fs_wedge_patterns(x, pat);
     int npat = w->growth_mode == FS_WEDGE_GROWTH_EIGENSTRAIN ? FS_WEDGE_PATTERNS : 3;
     memset(loads, 0, sizeof(double) * FS_WEDGE_PATTERNS * 18);
-    for (int q = 0; q < npat; q++)
+    /* K pat over the pattern's nonzero entries (a pattern moves a third to a half of the element's
+     * unknowns), in ascending order: the other terms are exact zeros, so the sums are the full ones
+     * bit for bit */
+    for (int q = 0; q < npat; q++) {
+        int nz[18], count = 0;
+        for (int c = 0; c < 18; c++)
+            if (pat[q][c] != 0.0)
+                nz[count++] = c;
         for (int a = 0; a < 18; a++) {
             double s = 0.0;
-            for (int c = 0; c < 18; c++)
-                s += K[18 * a + c] * pat[q][c];
+            for (int t = 0; t < count; t++)
+                s += K[18 * a + nz[t]] * pat[q][nz[t]];
             loads[q][a] = s;
         }
+    }
     return 0;
 }
 
