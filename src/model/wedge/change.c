@@ -514,7 +514,6 @@ static void mark_dirty(fs_wedge_model *w, const int32_t *nodes, int32_t nn)
 int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
 {
     double t0 = fs_seconds();
-    w->open_valid = false;
     int32_t n_free_old = w->n_free, n_fixed_old = w->n_fixed, n0 = c->n_nodes_before, e0 = c->n_tris_before;
     fs_wedge_grow_arrays(w, w->mesh->n_nodes, w->mesh->n_tris);
     for (int32_t i = n0; i < w->n_nodes; i++) {
@@ -552,6 +551,7 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
             nodes[nn++] = w->mesh->tri[3 * (size_t)changed[q] + k];
     for (int32_t q = 0; q < 2 * n_new; q++)
         nodes[nn++] = c->node_parent[q];
+    fs_wedge_open_update(w, nodes, nn);
     int rc = extend_system(w, n_free_old, n_fixed_old, changed, n_changed);
     if (rc == 0)
         rc = update_region(w, nodes, nn);

@@ -229,7 +229,8 @@ struct fs_wedge_model {
     int64_t griffith_stops;      /* tips retired by the Griffith criterion */
     uint8_t *open;               /* per node: 1 on a boundary edge of the mesh (a crack wall, a tip,
                                     the domain's border), while open_valid (wedge/split.c) */
-    bool open_valid;             /* cleared by every change of the mesh's connectivity */
+    bool open_valid;             /* kept up to a change by fs_wedge_apply_change, cleared by any other
+                                    change of the mesh's connectivity */
 };
 
 /* Builds the model on mesh (borrowed, kept by pointer; its edges and rings must be built, as
@@ -407,6 +408,12 @@ int fs_wedge_split_event(fs_wedge_model *w, int *changed);
  * method's event search looks at. Fills the nodal ratio cache of every candidate with its ratio, or
  * with an upper bound of it where the bound shows it is not the largest. */
 double fs_wedge_split_max_ratio(fs_wedge_model *w);
+
+/* Brings the open flags (w->open, while valid) up to a change of the mesh after which node_elem
+ * describes the mesh: recomputes the listed nodes' flags (repeats allowed), which must include every
+ * node whose boundary edges may have changed (the corners of the changed and new triangles, and the
+ * nodes that lost a triangle to a copy). */
+void fs_wedge_open_update(fs_wedge_model *w, const int32_t *nodes, int32_t n);
 
 /* fs_wedge_split_max_ratio of the state at time t blended between the snapshots a and b (taken right
  * after fs_wedge_split_max_ratio on an unchanged mesh, a->time <= t <= b->time), without changing the

@@ -221,9 +221,24 @@ static double cached_node_bound(fs_wedge_model *w, int32_t i, double level)
     return w->node_ratio[i];
 }
 
+/* Whether node i lies on a boundary edge of the mesh, from its element list (every triangle using
+ * it, node_elem). */
+static uint8_t node_open(const fs_wedge_model *w, int32_t i)
+{
+    const fs_mesh *m = w->mesh;
+    for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++) {
+        int32_t t = w->node_elem[p], c = fs_mesh_corner_of(m, t, i);
+        /* the two edges at corner c: c to c + 1 (edge c) and c - 1 to c (edge c - 1) */
+        if (m->adj[3 * (size_t)t + c] < 0 || m->adj[3 * (size_t)t + (c + 2) % 3] < 0)
+            return 1;
+    }
+    return 0;
+}
+
 /* w->open, brought up to date: open[i] = 1 for a node on a boundary edge of the mesh (a crack wall, a
- * tip or the domain's border). The flags stay valid until the mesh changes (fs_wedge_apply_change,
- * fs_wedge_subdivide), so the event search and the event share one pass over the mesh. */
+ * tip or the domain's border). The flags stay valid until the mesh changes: fs_wedge_apply_change
+ * brings them up to its change (fs_wedge_open_update), anything else (fs_wedge_subdivide) clears
+ * them, and the next call makes one pass over the mesh. */
 static const uint8_t *open_nodes(fs_wedge_model *w)
 {
     const fs_mesh *m = w->mesh;
@@ -238,6 +253,19 @@ static const uint8_t *open_nodes(fs_wedge_model *w)
         w->open_valid = true;
     }
     return w->open;
+}
+
+void fs_wedge_open_update(fs_wedge_model *w, const int32_t *nodes, int32_t n)
+{
+    if (!w->open_valid)
+        return;
+    w->open = fs_realloc(w->open, (size_t)w->n_nodes + 1);
+    for (int32_t q = 0; q < n; q++)
+        w->open[nodes[q]] = node_open(w, nodes[q]);
+#ifdef FS_VALIDATE
+    for (int32_t i = 0; i < w->n_nodes; i++)
+        FS_INVARIANT(w->open[i] == node_open(w, i), "wedge: node %d's open flag is stale after a change", (int)i);
+#endif
 }
 
 /* design: the nodal ratios are wanted only where they could be the largest (the event search) or over
