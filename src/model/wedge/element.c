@@ -110,23 +110,21 @@ int fs_wedge_elasticity(double young, double poisson, double D[36])
     return 0;
 }
 
-/* The strain-displacement matrix B (6x18, thesis §5.3.3) from the Cartesian derivatives. */
-static void strain_matrix(const double dndx[18], double B[6][18])
+/* design: the strain-displacement matrix B (6x18, thesis §5.3.3) has three nonzero entries per
+ * column: displacement component k of a node enters the strain rows STRAIN_ROW[k] (ascending)
+ * through its shape function's derivative along STRAIN_AXIS[k]. The products with B (D B, B' D B,
+ * B' sigma) run over those entries only, in the same ascending order as dense sums, whose other
+ * terms are exact zeros: the results are the dense products' bit for bit, at a third to a half of
+ * their multiplications. */
+static const int STRAIN_ROW[3][3] = {{0, 3, 5}, {1, 3, 4}, {2, 4, 5}};
+static const int STRAIN_AXIS[3][3] = {{0, 1, 2}, {1, 0, 2}, {2, 1, 0}};
+
+/* B's nonzero entries from the Cartesian derivatives: bval[j][t] is B[STRAIN_ROW[j % 3][t]][j]. */
+static void strain_entries(const double dndx[18], double bval[FS_WEDGE_DOF][3])
 {
-    memset(B, 0, 6 * 18 * sizeof(double));
-    for (int i = 0; i < FS_WEDGE_NODES; i++) {
-        double dx = dndx[3 * i], dy = dndx[3 * i + 1], dz = dndx[3 * i + 2];
-        int c = 3 * i;
-        B[0][c] = dx;
-        B[1][c + 1] = dy;
-        B[2][c + 2] = dz;
-        B[3][c] = dy;
-        B[3][c + 1] = dx;
-        B[4][c + 1] = dz;
-        B[4][c + 2] = dy;
-        B[5][c] = dz;
-        B[5][c + 2] = dx;
-    }
+    for (int j = 0; j < FS_WEDGE_DOF; j++)
+        for (int t = 0; t < 3; t++)
+            bval[j][t] = dndx[3 * (j / 3) + STRAIN_AXIS[j % 3][t]];
 }
 
 /* Strain (engineering shears) from the Cartesian derivatives: eps = B u, written out. */
@@ -164,14 +162,6 @@ int fs_wedge_volume(const double x[18], double *volume)
     return 0;
 }
 
-/* design: B has three nonzero entries per column: displacement component k of a node enters the strain
- * rows STRAIN_ROW[k] (ascending) through its shape function's derivative along STRAIN_AXIS[k]. The
- * products D B and B' (D B) run over those entries only, in the same ascending order as the dense
- * sums, whose other terms are exact zeros: the stiffness is the dense product's bit for bit, at half
- * its multiplications. */
-static const int STRAIN_ROW[3][3] = {{0, 3, 5}, {1, 3, 4}, {2, 4, 5}};
-static const int STRAIN_AXIS[3][3] = {{0, 1, 2}, {1, 0, 2}, {2, 1, 0}};
-
 int fs_wedge_stiffness(const double x[18], const double D[36], double K[324])
 {
     double Kup[FS_WEDGE_DOF][FS_WEDGE_DOF] = {{0}};
@@ -180,9 +170,7 @@ int fs_wedge_stiffness(const double x[18], const double D[36], double K[324])
         double dndx[18], detj, DB[6][FS_WEDGE_DOF], bval[FS_WEDGE_DOF][3];
         if (fs_wedge_gradients(x, p[0], p[1], p[2], dndx, &detj) < 0)
             return -1;
-        for (int j = 0; j < FS_WEDGE_DOF; j++)
-            for (int t = 0; t < 3; t++)
-                bval[j][t] = dndx[3 * (j / 3) + STRAIN_AXIS[j % 3][t]];
+        strain_entries(dndx, bval);
         for (int a = 0; a < 6; a++)
             for (int j = 0; j < FS_WEDGE_DOF; j++) {
                 const int *row = STRAIN_ROW[j % 3];
@@ -254,15 +242,17 @@ int fs_wedge_eigenstrain_force(const double x[18], const double D[36], const dou
     mat6_vec(D, eps0, sigma0);
     for (int g = 0; g < FS_WEDGE_GAUSS; g++) {
         const double *p = fs_wedge_gauss[g];
-        double dndx[18], detj, B[6][18];
+        double dndx[18], detj, bval[FS_WEDGE_DOF][3];
         if (fs_wedge_gradients(x, p[0], p[1], p[2], dndx, &detj) < 0)
             return -1;
-        strain_matrix(dndx, B);
+        strain_entries(dndx, bval);
         double wdet = detj * p[3];
         for (int i = 0; i < FS_WEDGE_DOF; i++) {
+            const int *row = STRAIN_ROW[i % 3];
             double sum = 0.0;
-            for (int a = 0; a < 6; a++)
-                sum += B[a][i] * sigma0[a];
+            sum += bval[i][0] * sigma0[row[0]];
+            sum += bval[i][1] * sigma0[row[1]];
+            sum += bval[i][2] * sigma0[row[2]];
             acc[i] += sum * wdet;
         }
     }

@@ -360,6 +360,13 @@ static void ratio_range(void *ctx, int32_t q0, int32_t q1)
     }
 }
 
+/* The smallest bound that could still tie with, or beat, the best exact ratio found (fracture/rank.h);
+ * it grows with best. */
+static double tie_floor(double best)
+{
+    return best - 2.0 * FS_RANK_TIE_REL * fabs(best);
+}
+
 /* Fewer listed elements than this are evaluated on the calling thread. */
 #define RATIO_PARALLEL_MIN 2048
 
@@ -402,7 +409,7 @@ int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_e
             return -1;
         }
         w->ratio[top.e] = best;
-        double lowest = best - 2.0 * FS_RANK_TIE_REL * fabs(best);
+        double lowest = tie_floor(best);
         int32_t kept = 0;
         for (int32_t q = 0; q < n; q++)
             if (list[q].e != top.e && list[q].bound >= lowest)
@@ -412,7 +419,7 @@ int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_e
             heap_down(list, n, i);
         for (int32_t left = n; left > 0;) {
             bound_entry next = list[0];
-            if (next.bound < best - 2.0 * FS_RANK_TIE_REL * fabs(best))
+            if (next.bound < tie_floor(best))
                 break;
             list[0] = list[--left];
             heap_down(list, left, 0);
