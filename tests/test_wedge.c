@@ -696,6 +696,89 @@ static void test_thickness_gradient_and_map(void)
     fs_mesh_free(&m);
 }
 
+/* Element e's strain energy computed afresh: half of u' K u with u its displacements net of the
+ * reference shape and eigenstrain (the patterns times the load coefficients), K at the assembled
+ * thickness. */
+static double fresh_energy(const fs_wedge_model *w, int32_t e)
+{
+    double K[324], loads[FS_WEDGE_PATTERNS][18], x[18], pat[FS_WEDGE_PATTERNS][18], coef[FS_WEDGE_PATTERNS], ue[18];
+    CHECK(fs_wedge_element_system(w, e, w->assembled_thickness, K, loads) == 0);
+    fs_wedge_element_coords(w, e, x);
+    fs_wedge_patterns(x, pat);
+    fs_wedge_load_coefficients(w, coef);
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 3; k++) {
+            ue[3 * c + k] = w->u[6 * (size_t)w->mesh->tri[3 * (size_t)e + c] + k];
+            ue[9 + 3 * c + k] = w->u[6 * (size_t)w->mesh->tri[3 * (size_t)e + c] + 3 + k];
+        }
+    for (int a = 0; a < 18; a++)
+        for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
+            ue[a] -= coef[q] * pat[q][a];
+    double energy = 0.0;
+    for (int a = 0; a < 18; a++) {
+        double f = 0.0;
+        for (int b = 0; b < 18; b++)
+            f += K[18 * a + b] * ue[b];
+        energy += f * ue[a];
+    }
+    return 0.5 * energy;
+}
+
+/* Every living element's kept energy (fs_wedge_element_energy, asked twice) against fresh_energy:
+ * the number that differ in any bit. */
+static int energies_differing(fs_wedge_model *w)
+{
+    int differ = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (int32_t e = 0; e < w->n_elems; e++)
+            differ += fs_wedge_element_energy(w, e) != fresh_energy(w, e);
+    return differ;
+}
+
+/* The element strain energies of Griffith's balance. A bonded layer under uniform shrinkage eps
+ * stores E eps^2 / (1 - nu) per volume away from its edges (the in-plane elastic strain is eps and
+ * the stress E eps / (1 - nu)). The energies each element keeps and reuses (equilibrium.c) equal
+ * fresh ones bit for bit: at equilibrium, after some displacements change, and after the layer
+ * thickens (its stiffnesses then fitted in thickness). */
+static void test_element_energy(void)
+{
+    for (int thickening = 0; thickening < 2; thickening++) {
+        fs_config cfg = base_config();
+        cfg.domain.width = cfg.domain.height = 6.0;
+        double eps = 1e-3;
+        cfg.shrink.top = ramp(eps);
+        cfg.shrink.bottom = ramp(eps);
+        if (thickening)
+            cfg.material.thickness_final = 0.4;
+        fs_mesh m = {0};
+        CHECK(wedge_test_mesh(&cfg, 1200, &m) == 0);
+        fs_wedge_model w;
+        CHECK(fs_wedge_init(&w, &m, SETUP(&cfg)) == 0);
+        CHECK(w.k_parts_on == (thickening == 1));
+        CHECK(fs_wedge_equilibrium(&w, 1.0) == 0);
+        double expect = cfg.material.young * eps * eps / (1.0 - cfg.material.poisson), worst = 0.0;
+        for (int32_t e = 0; e < w.n_elems; e++) {
+            double c[3], p[3][3];
+            centroid(&m, e, c);
+            if (border_distance(c, 6.0, 6.0) < 10.0 * w.assembled_thickness)
+                continue;
+            for (int k = 0; k < 3; k++)
+                fs_mesh_corner(&m, e, k, p[k]);
+            double area = 0.5 * fabs((p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]));
+            worst = fmax(worst, fabs(fs_wedge_element_energy(&w, e) / (area * w.assembled_thickness) - expect) / expect);
+        }
+        CHECK_MSG(worst < 0.01, "energy density off by %.3g of E eps^2 / (1 - nu)", worst);
+        CHECK(energies_differing(&w) == 0);
+        for (int32_t i = 0; i < w.n_nodes; i += 7)
+            w.u[6 * (size_t)i + 3] += 1e-5;
+        CHECK(energies_differing(&w) == 0);
+        CHECK(fs_wedge_equilibrium(&w, 0.5) == 0);
+        CHECK(energies_differing(&w) == 0);
+        fs_wedge_free(&w);
+        fs_mesh_free(&m);
+    }
+}
+
 int main(void)
 {
     RUN(test_bonded_layer_shrinkage);
@@ -712,5 +795,6 @@ int main(void)
     RUN(test_thickness_over_time);
     RUN(test_stiffness_parts);
     RUN(test_thickness_gradient_and_map);
+    RUN(test_element_energy);
     return check_finish();
 }

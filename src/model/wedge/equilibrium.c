@@ -591,20 +591,71 @@ int fs_wedge_nodal_stress(const fs_wedge_model *w, int32_t node, bool top, doubl
 }
 
 
-double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e)
+/* design: Griffith's balance (wedge/split.c) sums the strain energy of the elements within a few
+ * rings of a crack tip before and after each cut, some 160 elements. Nearly all of them are the same
+ * elements, with the same stiffness and mostly the same displacements, as at the balance before, so
+ * each element keeps the inputs of its stiffness (coordinates, corner thickness factors, modulus), the
+ * stiffness (its upper triangle: the quadrature's stiffness is symmetric entry for entry), and the
+ * displacements, load coefficients and energy last computed from them. A stiffness is kept only when
+ * the same inputs give the same one again (fs_wedge_stiffness_repeats), so the results are those of
+ * computing everything afresh, bit for bit. */
+#define ENERGY_INPUTS 22
+struct fs_wedge_energy_kept {
+    double in[ENERGY_INPUTS];        /* coordinates, corner thickness factors, Young's modulus; in[0]
+                                        NaN: none */
+    double k[FS_WEDGE_PAIRS];        /* the stiffness's upper triangle, row by row */
+    double u[18], coef[FS_WEDGE_PATTERNS]; /* the displacements and load coefficients of energy */
+    double energy;                   /* NaN: not computed for u and coef */
+};
+
+void fs_wedge_energy_kept_free(fs_wedge_model *w)
+{
+    if (!w->energy_kept)
+        return;
+    for (int32_t e = 0; e < w->elem_cap; e++)
+        free(w->energy_kept[e]);
+    free(w->energy_kept);
+    w->energy_kept = NULL;
+}
+
+double fs_wedge_element_energy(fs_wedge_model *w, int32_t e)
 {
     if (w->state[e] != FS_WEDGE_ALIVE)
         return 0.0;
-    double K[324], loads[FS_WEDGE_PATTERNS][18], x[18], pat[FS_WEDGE_PATTERNS][18], ue[18];
-    if (fs_wedge_element_system(w, e, w->assembled_thickness, K, loads) < 0) {
-        fs_error_clear();
-        return NAN;
+    struct fs_wedge_energy_kept *kept = w->energy_kept[e];
+    if (!kept) {
+        kept = w->energy_kept[e] = fs_malloc(sizeof *kept);
+        kept->in[0] = NAN;
     }
+    double in[ENERGY_INPUTS], x[18], u[18], coef[FS_WEDGE_PATTERNS], K[324];
     fs_wedge_element_coords(w, e, x);
-    fs_wedge_patterns(x, pat);
-    gather_u(w, e, ue);
-    double coef[FS_WEDGE_PATTERNS];
+    memcpy(in, x, sizeof x);
+    for (int c = 0; c < 3; c++)
+        in[18 + c] = w->thickness_factor[w->mesh->tri[3 * (size_t)e + c]];
+    in[21] = w->young[e];
+    gather_u(w, e, u);
     fs_wedge_load_coefficients(w, coef);
+    if (!isnan(kept->in[0]) && memcmp(in, kept->in, sizeof in) == 0) {
+        if (!isnan(kept->energy) && memcmp(u, kept->u, sizeof u) == 0 && memcmp(coef, kept->coef, sizeof coef) == 0)
+            return kept->energy;
+        for (int a = 0, q = 0; a < 18; a++)
+            for (int b = a; b < 18; b++, q++)
+                K[18 * a + b] = K[18 * b + a] = kept->k[q];
+    } else {
+        if (fs_wedge_element_stiffness(w, e, w->assembled_thickness, x, K) < 0) {
+            fs_error_clear();
+            return NAN;
+        }
+        for (int a = 0, q = 0; a < 18; a++)
+            for (int b = a; b < 18; b++, q++)
+                kept->k[q] = K[18 * a + b];
+        memcpy(kept->in, in, sizeof in);
+        if (!fs_wedge_stiffness_repeats(w, e))
+            kept->in[0] = NAN; /* used this once */
+    }
+    double pat[FS_WEDGE_PATTERNS][18], ue[18];
+    fs_wedge_patterns(x, pat);
+    memcpy(ue, u, sizeof u);
     for (int a = 0; a < 18; a++)
         for (int q = 0; q < FS_WEDGE_PATTERNS; q++)
             ue[a] -= coef[q] * pat[q][a];
@@ -615,5 +666,9 @@ double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e)
             f += K[18 * a + b] * ue[b];
         energy += f * ue[a];
     }
-    return 0.5 * energy;
+    energy *= 0.5;
+    memcpy(kept->u, u, sizeof u);
+    memcpy(kept->coef, coef, sizeof coef);
+    kept->energy = isnan(kept->in[0]) ? NAN : energy;
+    return energy;
 }

@@ -126,6 +126,8 @@ struct fs_wedge_model {
     /* Nodes: mesh node i has a bottom node and a top node; "node DOF" 6 i + k is component k of the
      * bottom node (k < 3) or of the top node (k >= 3). */
     int32_t n_nodes;
+    int32_t node_cap, elem_cap;  /* nodes and elements the per-node and per-element arrays have room for
+                                    (fs_wedge_grow_arrays) */
     double *normal;              /* 3 per node: unit extrusion direction (flat frames: +z) */
     double *thickness_factor;    /* per node: thickness map and gradient factor (times the thickness at t) */
     uint8_t *pinned;             /* per node: 1 if its top node is prescribed too (patch tests), else 0 */
@@ -136,6 +138,7 @@ struct fs_wedge_model {
                                     dead ones too) starts in node_elem */
     int32_t *node_elem_count;    /* per node: entries of its list */
     int32_t *node_elem_room;     /* per node: entries its list may grow to in place */
+    int32_t node_elem_cap;       /* nodes node_elem_start and node_elem_room have room for */
     int32_t *node_elem;
     int32_t node_elem_used, node_elem_capacity; /* entries of node_elem handed out, allocated */
 
@@ -173,6 +176,8 @@ struct fs_wedge_model {
                                     NaN for the corners of every element whose stresses or
                                     neighbourhood change */
     uint8_t *node_ratio_exact;   /* per node: 1 where node_ratio holds the ratio itself */
+    struct fs_wedge_energy_kept **energy_kept; /* per element: what its last strain energy was computed
+                                    from (fs_wedge_element_energy), allocated at its first; NULL before */
     double *ratio_lipschitz;     /* per element: bound of the change of its ratio per cm of change of
                                     its 18 nodal displacements (Euclidean norm) */
     double *ratio_ref_bound;     /* per element: its ratio bound at the last full evaluation (NaN:
@@ -390,8 +395,10 @@ int fs_wedge_update_geometry(fs_wedge_model *w, const int32_t *elems, int32_t n)
 
 /* Elastic strain energy (MPa cm^3 = J) of living element e at the current equilibrium: half the dot
  * product of its nodal forces and displacements net of the shrinkage reference shape and growth
- * eigenstrain (thesis Algorithm 11). 0 for a removed element; NaN if the element degenerates. */
-double fs_wedge_element_energy(const fs_wedge_model *w, int32_t e);
+ * eigenstrain (thesis Algorithm 11). 0 for a removed element; NaN if the element degenerates. Keeps
+ * what it computed in w->energy_kept (see equilibrium.c). */
+double fs_wedge_element_energy(fs_wedge_model *w, int32_t e);
+void fs_wedge_energy_kept_free(fs_wedge_model *w);
 
 /* One fracture event by element splitting at the current time (thesis §5.7, Algorithms 10-12; see
  * wedge/split.c): the crack tip with the largest nodal ratio over 1 extends, or if no tip is over its
@@ -572,7 +579,9 @@ void fs_wedge_grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems);
 
 /* system.c: the global system. DOF numbering (free first, in node order), the DOF of element e's
  * node a (0..5), the node element lists (built, or updated after a change: see system.c), the living
- * elements at node i, element e's stiffness and unit loads, the slot of entry (i, j) of an upper CSC
+ * elements at node i, element e's coordinates and stiffness, whether the same inputs give e the same
+ * stiffness again (not so while a stiffness fitted in thickness waits for its fit: see k_parts),
+ * element e's stiffness and unit loads, the slot of entry (i, j) of an upper CSC
  * matrix (-1 if absent), the coupling's column operations, the whole assembly, re-adding elements into
  * the pattern (only the marked DOFs' entries when only is not NULL), new values on the same pattern,
  * and the CHOLMOD factorization (with a new analysis when analyze is set). Return 0 or -1 with
@@ -583,6 +592,8 @@ void fs_wedge_build_node_elems(fs_wedge_model *w);
 void fs_wedge_update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const int32_t *changed, int32_t n_changed,
                                 const int32_t *lost, int32_t nl);
 int32_t fs_wedge_alive_at_node(const fs_wedge_model *w, int32_t i);
+int fs_wedge_element_stiffness(const fs_wedge_model *w, int32_t e, double base_thickness, double x[18], double K[324]);
+bool fs_wedge_stiffness_repeats(const fs_wedge_model *w, int32_t e);
 int fs_wedge_element_system(const fs_wedge_model *w, int32_t e, double base_thickness, double K[324],
                             double loads[FS_WEDGE_PATTERNS][18]);
 int32_t fs_wedge_find_entry(const fs_sparse_matrix *m, int32_t i, int32_t j);

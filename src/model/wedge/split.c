@@ -556,7 +556,7 @@ static void griffith_region(const fs_wedge_model *w, int32_t n, ilist *out)
     free(seen_elem);
 }
 
-static double region_energy(const fs_wedge_model *w, const ilist *region, int32_t first_new)
+static double region_energy(fs_wedge_model *w, const ilist *region, int32_t first_new)
 {
     double e = 0.0;
     for (int32_t q = 0; q < region->n; q++)

@@ -53,7 +53,7 @@ void fs_wedge_build_node_elems(fs_wedge_model *w)
     int32_t n = w->n_nodes;
     free(w->node_elem_start);
     free(w->node_elem);
-    w->node_elem_start = fs_calloc((size_t)n + 1, sizeof *w->node_elem_start);
+    w->node_elem_start = fs_calloc((size_t)w->node_cap + 1, sizeof *w->node_elem_start);
     for (int32_t e = 0; e < w->n_elems; e++)
         for (int c = 0; c < 3; c++)
             w->node_elem_start[w->mesh->tri[3 * (size_t)e + c] + 1]++;
@@ -71,7 +71,8 @@ void fs_wedge_build_node_elems(fs_wedge_model *w)
                 continue;
             w->node_elem[fill[node]++] = e;
         }
-    w->node_elem_room = fs_realloc(w->node_elem_room, ((size_t)n + 1) * sizeof *w->node_elem_room);
+    FS_ARRAY_RESIZE(w->node_elem_room, (size_t)w->node_cap + 1);
+    w->node_elem_cap = w->node_cap;
     for (int32_t i = 0; i < n; i++) {
         w->node_elem_count[i] = fill[i] - w->node_elem_start[i];
         w->node_elem_room[i] = w->node_elem_start[i + 1] - w->node_elem_start[i];
@@ -125,8 +126,11 @@ void fs_wedge_update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const
     int32_t n_new_elems = w->n_elems - e0;
     int32_t *cand = fs_malloc(((size_t)n_changed + n_new_elems + 64) * sizeof *cand);
     int32_t cap_cand = n_changed + n_new_elems + 64;
-    w->node_elem_start = fs_realloc(w->node_elem_start, ((size_t)w->n_nodes + 1) * sizeof *w->node_elem_start);
-    w->node_elem_room = fs_realloc(w->node_elem_room, ((size_t)w->n_nodes + 1) * sizeof *w->node_elem_room);
+    if (w->node_elem_cap < w->node_cap) {
+        FS_ARRAY_RESIZE(w->node_elem_start, (size_t)w->node_cap + 1);
+        FS_ARRAY_RESIZE(w->node_elem_room, (size_t)w->node_cap + 1);
+        w->node_elem_cap = w->node_cap;
+    }
     for (int32_t i = n0; i < w->n_nodes; i++) {
         w->node_elem_start[i] = node_elem_take(w, NODE_ELEM_SLACK);
         w->node_elem_room[i] = NODE_ELEM_SLACK;
@@ -235,10 +239,9 @@ static int element_stiffness(const fs_wedge_model *w, int32_t e, double h, const
     return 0;
 }
 
-int fs_wedge_element_system(const fs_wedge_model *w, int32_t e, double base_thickness, double K[324],
-                             double loads[FS_WEDGE_PATTERNS][18])
+int fs_wedge_element_stiffness(const fs_wedge_model *w, int32_t e, double base_thickness, double x[18], double K[324])
 {
-    double x[18], D[36];
+    double D[36];
     fs_wedge_coords_at(w, e, base_thickness, x);
     for (int i = 0; i < 36; i++)
         D[i] = w->young[e] * w->d_unit[i];
@@ -246,6 +249,20 @@ int fs_wedge_element_system(const fs_wedge_model *w, int32_t e, double base_thic
         fs_error(FS_ERR_DATA, "wedge model: element %d is inverted or degenerate (%s)", (int)e, fs_error_message());
         return -1;
     }
+    return 0;
+}
+
+bool fs_wedge_stiffness_repeats(const fs_wedge_model *w, int32_t e)
+{
+    return !w->k_parts_on || !isnan(w->k_parts[3 * FS_WEDGE_PAIRS * (size_t)e]);
+}
+
+int fs_wedge_element_system(const fs_wedge_model *w, int32_t e, double base_thickness, double K[324],
+                             double loads[FS_WEDGE_PATTERNS][18])
+{
+    double x[18];
+    if (fs_wedge_element_stiffness(w, e, base_thickness, x, K) < 0)
+        return -1;
     double pat[FS_WEDGE_PATTERNS][18];
     fs_wedge_patterns(x, pat);
     int npat = w->growth_mode == FS_WEDGE_GROWTH_EIGENSTRAIN ? FS_WEDGE_PATTERNS : 3;

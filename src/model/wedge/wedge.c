@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/rng.h"
 #include "base/vec.h"
@@ -154,45 +155,64 @@ static void element_materials(fs_wedge_model *w, int32_t e, const fs_grey_map *y
     w->threshold[e] = 1e-3 * mat->threshold * jitter * map_average(tmap, &w->mesh->domain, corner);
 }
 
+/* Room for n, with a quarter more when it grows past cap: the arrays are reallocated a few times in
+ * a run instead of at every cut (each cut adds a few nodes and elements). */
+static bool grow_capacity(int32_t *cap, int32_t n)
+{
+    if (n <= *cap)
+        return false;
+    *cap = n + n / 4 + 16;
+    return true;
+}
+
 void fs_wedge_grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
 {
+    if (grow_capacity(&w->node_cap, n_nodes)) {
+        size_t nn = (size_t)w->node_cap;
+        FS_ARRAY_RESIZE(w->normal, 3 * nn);
+        FS_ARRAY_RESIZE(w->thickness_factor, nn);
+        FS_ARRAY_RESIZE(w->pinned, nn);
+        FS_ARRAY_RESIZE(w->origin, nn);
+        FS_ARRAY_RESIZE(w->prescribed, 6 * nn);
+        FS_ARRAY_RESIZE(w->u, 6 * nn);
+        FS_ARRAY_RESIZE(w->node_elem_count, nn);
+        FS_ARRAY_RESIZE(w->node_ratio, nn);
+        FS_ARRAY_RESIZE(w->node_ratio_exact, nn);
+    }
+    size_t old_cap = (size_t)w->elem_cap;
+    if (grow_capacity(&w->elem_cap, n_elems)) {
+        size_t ne = (size_t)w->elem_cap;
+        FS_ARRAY_RESIZE(w->state, ne);
+        FS_ARRAY_RESIZE(w->young, ne);
+        if (w->k_parts_on) {
+            FS_ARRAY_RESIZE(w->k_parts, 3 * FS_WEDGE_PAIRS * ne);
+            FS_ARRAY_RESIZE(w->k_key, FS_WEDGE_K_KEY * ne);
+        }
+        FS_ARRAY_RESIZE(w->threshold, ne);
+        FS_ARRAY_RESIZE(w->ratio, ne);
+        FS_ARRAY_RESIZE(w->stress_top, 18 * ne);
+        FS_ARRAY_RESIZE(w->gauss_cache, FS_WEDGE_GAUSS_CACHE * ne);
+        FS_ARRAY_RESIZE(w->edge_rest, 3 * ne);
+        FS_ARRAY_RESIZE(w->ratio_lipschitz, ne);
+        FS_ARRAY_RESIZE(w->ratio_ref_bound, ne);
+        FS_ARRAY_RESIZE(w->ratio_ref_u, 18 * ne);
+        FS_ARRAY_RESIZE(w->energy_kept, ne);
+        for (size_t e = old_cap; e < ne; e++)
+            w->energy_kept[e] = NULL;
+    }
     size_t nn = (size_t)n_nodes, ne = (size_t)n_elems;
-    w->normal = fs_realloc(w->normal, 3 * nn * sizeof *w->normal);
-    w->thickness_factor = fs_realloc(w->thickness_factor, nn * sizeof *w->thickness_factor);
-    w->pinned = fs_realloc(w->pinned, nn * sizeof *w->pinned);
-    w->origin = fs_realloc(w->origin, nn * sizeof *w->origin);
-    w->prescribed = fs_realloc(w->prescribed, 6 * nn * sizeof *w->prescribed);
-    w->u = fs_realloc(w->u, 6 * nn * sizeof *w->u);
-    w->node_elem_count = fs_realloc(w->node_elem_count, nn * sizeof *w->node_elem_count);
     for (size_t i = (size_t)w->n_nodes; i < nn; i++) {
         w->pinned[i] = 0;
         w->origin[i] = -1;
         memset(w->prescribed + 6 * i, 0, 6 * sizeof *w->prescribed);
         memset(w->u + 6 * i, 0, 6 * sizeof *w->u);
         node_normal(w, (int32_t)i, w->normal + 3 * i);
-    }
-    w->state = fs_realloc(w->state, ne * sizeof *w->state);
-    w->young = fs_realloc(w->young, ne * sizeof *w->young);
-    if (w->k_parts_on) {
-        w->k_parts = fs_realloc(w->k_parts, 3 * FS_WEDGE_PAIRS * ne * sizeof *w->k_parts);
-        w->k_key = fs_realloc(w->k_key, FS_WEDGE_K_KEY * ne * sizeof *w->k_key);
-        for (size_t q = FS_WEDGE_K_KEY * (size_t)w->n_elems; q < FS_WEDGE_K_KEY * ne; q++)
-            w->k_key[q] = NAN;
-    }
-    w->threshold = fs_realloc(w->threshold, ne * sizeof *w->threshold);
-    w->ratio = fs_realloc(w->ratio, ne * sizeof *w->ratio);
-    w->stress_top = fs_realloc(w->stress_top, 18 * ne * sizeof *w->stress_top);
-    w->gauss_cache = fs_realloc(w->gauss_cache, FS_WEDGE_GAUSS_CACHE * ne * sizeof *w->gauss_cache);
-    w->edge_rest = fs_realloc(w->edge_rest, 3 * ne * sizeof *w->edge_rest);
-    w->node_ratio = fs_realloc(w->node_ratio, nn * sizeof *w->node_ratio);
-    w->node_ratio_exact = fs_realloc(w->node_ratio_exact, nn * sizeof *w->node_ratio_exact);
-    for (size_t i = (size_t)w->n_nodes; i < nn; i++) {
         w->node_ratio[i] = NAN;
         w->node_ratio_exact[i] = 0;
     }
-    w->ratio_lipschitz = fs_realloc(w->ratio_lipschitz, ne * sizeof *w->ratio_lipschitz);
-    w->ratio_ref_bound = fs_realloc(w->ratio_ref_bound, ne * sizeof *w->ratio_ref_bound);
-    w->ratio_ref_u = fs_realloc(w->ratio_ref_u, 18 * ne * sizeof *w->ratio_ref_u);
+    if (w->k_parts_on)
+        for (size_t q = FS_WEDGE_K_KEY * (size_t)w->n_elems; q < FS_WEDGE_K_KEY * ne; q++)
+            w->k_key[q] = NAN;
     for (size_t e = (size_t)w->n_elems; e < ne; e++) {
         w->state[e] = FS_WEDGE_ALIVE;
         w->ratio[e] = NAN;
@@ -297,6 +317,7 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->ratio_lipschitz);
     free(w->ratio_ref_bound);
     free(w->ratio_ref_u);
+    fs_wedge_energy_kept_free(w);
     free(w->dof);
     free(w->fixed_node_dof);
     free(w->node_elem_start);
