@@ -544,9 +544,12 @@ static int triangulate_sphere(fs_mesh *m)
 
 /* ---- plane, periodic plane and cylinder ---- */
 
-/* Points per block; a large set is cut into blocks triangulated in parallel. */
+/* Points per block; a large set is cut into blocks triangulated in parallel, at most MAX_BLOCKS
+ * strips. Smaller Qhull runs are faster per point: a million evenly spaced points triangulate about
+ * a tenth faster in 16 strips than in 8, while 31 or 62 strips of 32768 or 16384 points gain nothing
+ * more (the margins copied beyond each strip grow relative to it). */
 #define BLOCK_POINTS 65536
-#define MAX_BLOCKS 8
+#define MAX_BLOCKS 16
 
 typedef struct {
     int32_t n;
