@@ -4,6 +4,7 @@
 #include "config.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -659,8 +660,8 @@ int fs_wedge_readd(fs_wedge_model *w, const int32_t *elems, int32_t n, const uin
 }
 
 /* design: a layer that thickens is refilled at every equilibrium at a new thickness, every element
- * anew. Its element systems and Gauss caches (each element writing only its own slots, its stiffness
- * parts included) are computed on several threads, REFILL_CHUNK elements at a time into a buffer,
+ * anew. Its element systems (each element writing only its own slots, its stiffness parts included)
+ * are computed on several threads, REFILL_CHUNK elements at a time into a buffer,
  * and added into the pattern on the calling thread in element order: the values are those of one
  * loop, whatever the threads. Where each pair of an element's DOFs lies in the pattern is looked up
  * once per pattern (on the threads too) and kept in refill_slot: the event search refills the same
@@ -698,8 +699,7 @@ static void refill_range(void *ctx, int32_t i0, int32_t i1)
     for (int32_t i = i0; i < i1; i++) {
         int32_t e = c->e0 + i;
         c->failed[i] = w->state[e] == FS_WEDGE_ALIVE &&
-                       (fs_wedge_element_system(w, e, w->assembled_thickness, c->k + 324 * (size_t)i, c->loads[i]) < 0 ||
-                        fs_wedge_refresh_cache(w, &e, 1) < 0);
+                       fs_wedge_element_system(w, e, w->assembled_thickness, c->k + 324 * (size_t)i, c->loads[i]) < 0;
         if (c->slots && w->state[e] == FS_WEDGE_ALIVE) {
             /* each thread its own view of the chunk, pointing at the element's slots */
             refill_chunk mine = *c;
@@ -721,6 +721,64 @@ static void add_at_slot(void *ctx, int q, int32_t i, int32_t j, double v)
         c->w->k_free.values[c->slot[q]] += v;
     else
         c->w->k_fb.value[-2 - c->slot[q]] += v;
+}
+
+/* design: at a new thickness the stress check's element caches (fs_wedge_refresh_cache) are needed
+ * only once the system is solved, and the factorization runs on one thread (CHOLMOD's BLAS is kept on
+ * one), so the caches are refreshed on a second thread while the calling thread factorizes, in
+ * parallel parts when nothing is factorized. Each writes only its own data (the factor; each
+ * element's caches), so the results are those of one after the other, for any thread count. */
+typedef struct {
+    fs_wedge_model *w;
+    uint8_t *failed;            /* per element: its cache failed (degenerate) */
+    int factor_rc;              /* fs_wedge_factorize's, and its error where it failed */
+    fs_errdomain factor_domain;
+    char factor_message[512];
+} refresh_job;
+
+static void refresh_range(void *ctx, int32_t e0, int32_t e1)
+{
+    refresh_job *j = ctx;
+    for (int32_t e = e0; e < e1; e++)
+        if (fs_wedge_refresh_cache(j->w, &e, 1) < 0) {
+            j->failed[e] = 1;
+            fs_error_clear();
+        }
+}
+
+static void refresh_item(void *ctx, int32_t i)
+{
+    refresh_job *j = ctx;
+    if (i == 1) {
+        refresh_range(j, 0, j->w->n_elems);
+        return;
+    }
+    j->factor_rc = fs_wedge_factorize(j->w, false);
+    if (j->factor_rc < 0) { /* the error is this thread's own: carried to the caller's */
+        j->factor_domain = fs_error_domain();
+        snprintf(j->factor_message, sizeof j->factor_message, "%s", fs_error_message());
+        fs_error_clear();
+    }
+}
+
+/* Re-factorizes (fs_wedge_factorize, without a new analysis) and refreshes every element's caches. */
+static int factorize_and_refresh(fs_wedge_model *w)
+{
+    refresh_job j = {w, fs_calloc((size_t)w->n_elems + 1, 1), 0, FS_OK, ""};
+    if (w->cfg.solver.method == FS_SOLVER_CHOLMOD && w->n_free > 0)
+        fs_parallel_for(2, 0, refresh_item, &j);
+    else
+        fs_parallel_ranges(w->n_elems, 256, refresh_range, &j);
+    int rc = 0;
+    for (int32_t e = 0; e < w->n_elems && rc == 0; e++)
+        if (j.failed[e]) /* again on this thread, for its message */
+            rc = fs_wedge_refresh_cache(w, &e, 1);
+    free(j.failed);
+    if (rc == 0 && j.factor_rc < 0) {
+        fs_error(j.factor_domain, "%s", j.factor_message);
+        rc = -1;
+    }
+    return rc;
 }
 
 /* New values on the same pattern (a changed thickness): zero, re-add every living element in order,
@@ -749,9 +807,7 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
         for (int32_t i = 0; i < n && rc == 0; i++) {
             int32_t e = c.e0 + i;
             if (c.failed[i]) /* again on this thread, for its message (an error is the thread's own) */
-                rc = fs_wedge_element_system(w, e, base_thickness, c.k + 324 * (size_t)i, c.loads[i]) < 0
-                         ? -1
-                         : fs_wedge_refresh_cache(w, &e, 1);
+                rc = fs_wedge_element_system(w, e, base_thickness, c.k + 324 * (size_t)i, c.loads[i]);
             if (rc == 0 && w->state[e] == FS_WEDGE_ALIVE) {
                 c.slot = w->refill_slot + FS_WEDGE_PAIRS * (size_t)e;
                 element_pairs(w, e, c.k + 324 * (size_t)i, add_at_slot, &c);
@@ -768,5 +824,5 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
         return -1;
     fix_orphans(w);
     w->counters.assemble_seconds += fs_seconds() - t0;
-    return fs_wedge_factorize(w, false);
+    return factorize_and_refresh(w);
 }
