@@ -550,12 +550,9 @@ int fs_wedge_update_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n)
 void fs_wedge_prescribe_fixed(fs_wedge_model *w)
 {
     fixed_displacements(w, w->time);
-    for (int32_t i = 0; i < w->n_nodes; i++)
-        for (int l = 0; l < 6; l++) {
-            int32_t g = w->dof[6 * (size_t)i + l];
-            if (g >= w->n_free)
-                w->u[6 * (size_t)i + l] = w->u_fixed[g - w->n_free];
-        }
+    /* fixed_node_dof lists the node DOF of each fixed one (fs_wedge_number_dofs) */
+    for (int32_t j = 0; j < w->n_fixed; j++)
+        w->u[w->fixed_node_dof[j]] = w->u_fixed[j];
 }
 
 double fs_wedge_max_ratio(const fs_wedge_model *w)

@@ -189,6 +189,7 @@ struct fs_wedge_model {
     int32_t n_free, n_fixed;
     int32_t *dof;                /* 6 per node: index of each node DOF in that numbering */
     int32_t *fixed_node_dof;     /* n_fixed: the node DOF (6 i + k) of each fixed index */
+    int32_t dof_cap;             /* nodes dof and fixed_node_dof have room for */
     fs_sparse_matrix k_free;     /* upper CSC of order n_free: K_ff (its row and value arrays have
                                     room for k_free_capacity entries: they grow geometrically as the
                                     mesh is cut, see extend_system) */

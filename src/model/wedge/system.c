@@ -28,12 +28,15 @@ int32_t fs_wedge_elem_dof(const fs_wedge_model *w, int32_t e, int a)
 void fs_wedge_number_dofs(fs_wedge_model *w)
 {
     int32_t n = w->n_nodes, next = 0;
-    w->dof = fs_realloc(w->dof, 6 * (size_t)n * sizeof *w->dof);
+    if (w->dof_cap < n) { /* with the per-node arrays' room (fs_wedge_grow_arrays) */
+        w->dof_cap = w->node_cap > n ? w->node_cap : n;
+        FS_ARRAY_RESIZE(w->dof, 6 * (size_t)w->dof_cap);
+        FS_ARRAY_RESIZE(w->fixed_node_dof, 6 * (size_t)w->dof_cap);
+    }
     for (int32_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++)
             w->dof[6 * (size_t)i + 3 + k] = w->pinned[i] ? -1 : next++;
     w->n_free = next;
-    w->fixed_node_dof = fs_realloc(w->fixed_node_dof, 6 * (size_t)n * sizeof *w->fixed_node_dof);
     for (int32_t i = 0; i < n; i++)
         for (int l = 0; l < 6; l++) {
             int32_t *d = w->dof + 6 * (size_t)i + l;
