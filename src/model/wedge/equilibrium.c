@@ -285,10 +285,11 @@ static void heap_down(bound_entry *h, int32_t n, int32_t i)
 
 /* design: thesis §5.6.1 evaluates the stress at the three Gauss points nearest the top face ("the
  * resulting 9 values are sorted, and the largest one is compared against the material's threshold
- * stress"). Every fracture decision asks only whether the largest ratio exceeds 1 and which element
- * has it (fracture/rank.h, ties within FS_RANK_TIE_REL), so the shared eigen kernel runs only on the
- * elements whose upper bound (fs_eigen_principal_bound) could reach the largest exact ratio, in
- * descending order of the bound, until the next bound falls below the best exact ratio found (less
+ * stress"). Every removal asks only whether the largest ratio exceeds 1 and which element has it
+ * (fracture/rank.h, ties within FS_RANK_TIE_REL; splitting decides on nodal ratios computed from the
+ * stresses, wedge/split.c, and leaves the element ratios as bounds), so the shared eigen kernel runs
+ * only on the elements whose upper bound (fs_eigen_principal_bound) could reach the largest exact
+ * ratio, in descending order of the bound, until the next bound falls below the best exact ratio found (less
  * the tie tolerance). Every other ratio holds its bound. Where the layer holds many elements over 1
  * that do not break (Griffith's criterion stops cracks), the candidates come off a binary heap, in
  * the same order as a sort, which would cost n log n at every call for the few that are needed; the
@@ -387,6 +388,12 @@ int fs_wedge_element_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n_e
         if (pass.touched[q])
             touch_nodes(w, elems ? elems[q] : q);
     free(pass.touched);
+    if (w->cfg.fracture.method == FS_FRACTURE_SPLIT) {
+        /* splitting decides on nodal ratios from the stresses (wedge/split.c): only removal picks
+         * from the element ratios, so they stay bounds */
+        w->counters.stress_seconds += fs_seconds() - t0;
+        return 0;
+    }
     /* the elements over 1 and the first candidate among them; then the heap of those that could
      * still come off it: bounds within the tie tolerance of its exact ratio or over it (best only
      * grows) */

@@ -159,9 +159,10 @@ struct fs_wedge_model {
     double *threshold;           /* per element: threshold stress (MPa), with the map and jitter */
     double *ratio;               /* per element, at the current equilibrium: the largest principal
                                     stress at the three top Gauss points over the threshold, or an
-                                    upper bound of it; exact for the largest ratio and every ratio that
-                                    ties with it when that is over 1 (what fracture decides on, see
-                                    equilibrium.c); NaN when not alive. fs_wedge_element_ratio is exact. */
+                                    upper bound of it; with fracture by removal, exact for the largest
+                                    ratio and every ratio that ties with it when that is over 1 (what
+                                    removal decides on, see equilibrium.c; splitting decides on nodal
+                                    ratios); NaN when not alive. fs_wedge_element_ratio is exact. */
     double *stress_top;          /* 18 per element: Voigt stress (MPa) at the top Gauss points 0..2;
                                     with lazy_ratios, as of the element's last full evaluation */
     double *gauss_cache;         /* 108 per element: geometry terms of the stress check (FS_WEDGE_GAUSS_CACHE) */
