@@ -612,14 +612,12 @@ struct fs_wedge_energy_kept {
     double energy;                   /* NaN: not computed for u and coef */
 };
 
-void fs_wedge_energy_kept_free(fs_wedge_model *w)
+void fs_wedge_energy_forget(fs_wedge_model *w)
 {
-    if (!w->energy_kept)
-        return;
-    for (int32_t e = 0; e < w->elem_cap; e++)
+    for (int32_t e = 0; w->energy_kept && e < w->elem_cap; e++) {
         free(w->energy_kept[e]);
-    free(w->energy_kept);
-    w->energy_kept = NULL;
+        w->energy_kept[e] = NULL;
+    }
 }
 
 double fs_wedge_element_energy(fs_wedge_model *w, int32_t e)

@@ -400,7 +400,9 @@ int fs_wedge_update_geometry(fs_wedge_model *w, const int32_t *elems, int32_t n)
  * eigenstrain (thesis Algorithm 11). 0 for a removed element; NaN if the element degenerates. Keeps
  * what it computed in w->energy_kept (see equilibrium.c). */
 double fs_wedge_element_energy(fs_wedge_model *w, int32_t e);
-void fs_wedge_energy_kept_free(fs_wedge_model *w);
+
+/* Drops what every element kept of its energy (the next energies are computed afresh). */
+void fs_wedge_energy_forget(fs_wedge_model *w);
 
 /* One fracture event by element splitting at the current time (thesis §5.7, Algorithms 10-12; see
  * wedge/split.c): the crack tip with the largest nodal ratio over 1 extends, or if no tip is over its

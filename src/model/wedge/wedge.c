@@ -317,7 +317,8 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->ratio_lipschitz);
     free(w->ratio_ref_bound);
     free(w->ratio_ref_u);
-    fs_wedge_energy_kept_free(w);
+    fs_wedge_energy_forget(w);
+    free(w->energy_kept);
     free(w->dof);
     free(w->fixed_node_dof);
     free(w->node_elem_start);
