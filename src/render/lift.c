@@ -7,6 +7,7 @@
 
 #include "base/array.h"
 #include "base/error.h"
+#include "base/imap.h"
 #include "base/log.h"
 #include "base/uf.h"
 #include "base/vec.h"
@@ -20,82 +21,6 @@ static const double weld_fraction = 2.5e-7;
 /* Corner normals average the triangles within this angle of their own triangle (degrees). */
 static const double crease_degrees = 50.0;
 
-/* ---- an open-addressing map from 64-bit keys (never UINT64_MAX) to int32 values ---- */
-
-typedef struct {
-    uint64_t key;
-    int32_t val;
-} imap_slot;
-
-typedef struct {
-    imap_slot *slot;
-    size_t cap, n; /* cap is a power of two */
-} imap;
-
-static uint64_t mix64(uint64_t x)
-{
-    x ^= x >> 30;
-    x *= UINT64_C(0xbf58476d1ce4e5b9);
-    x ^= x >> 27;
-    x *= UINT64_C(0x94d049bb133111eb);
-    x ^= x >> 31;
-    return x == UINT64_MAX ? UINT64_MAX - 1 : x;
-}
-
-static void imap_init(imap *m, size_t expect)
-{
-    m->cap = 64;
-    while (m->cap < 2 * expect + 16)
-        m->cap *= 2;
-    m->n = 0;
-    m->slot = fs_malloc(m->cap * sizeof *m->slot);
-    for (size_t i = 0; i < m->cap; i++)
-        m->slot[i].key = UINT64_MAX;
-}
-
-static void imap_free(imap *m)
-{
-    free(m->slot);
-    memset(m, 0, sizeof *m);
-}
-
-static size_t imap_index(const imap *m, uint64_t key)
-{
-    size_t i = (size_t)mix64(key) & (m->cap - 1);
-    while (m->slot[i].key != UINT64_MAX && m->slot[i].key != key)
-        i = (i + 1) & (m->cap - 1);
-    return i;
-}
-
-static int32_t *imap_find(const imap *m, uint64_t key)
-{
-    size_t i = imap_index(m, key);
-    return m->slot[i].key == key ? &m->slot[i].val : NULL;
-}
-
-/* The value slot of key; a missing key is inserted with value `fresh` and *found set false. */
-static int32_t *imap_get(imap *m, uint64_t key, int32_t fresh, bool *found)
-{
-    if (2 * (m->n + 1) > m->cap) {
-        imap old = *m;
-        imap_init(m, old.cap);
-        for (size_t i = 0; i < old.cap; i++)
-            if (old.slot[i].key != UINT64_MAX) {
-                m->slot[imap_index(m, old.slot[i].key)] = old.slot[i];
-                m->n++;
-            }
-        imap_free(&old);
-    }
-    size_t i = imap_index(m, key);
-    *found = m->slot[i].key == key;
-    if (!*found) {
-        m->slot[i].key = key;
-        m->slot[i].val = fresh;
-        m->n++;
-    }
-    return &m->slot[i].val;
-}
-
 static uint64_t pair_key(int32_t a, int32_t b) { return (uint64_t)(uint32_t)a << 32 | (uint32_t)b; }
 
 /* ---- welding points within a tolerance through a hashed grid of cells at least four times the
@@ -105,14 +30,14 @@ typedef struct {
     double cell[3], tol, tol2;
     double period[3];   /* > 0 on a periodic axis */
     long long n_cells[3]; /* cells along a periodic axis */
-    imap grid;          /* hashed cell -> newest point in it (others chained through next) */
+    fs_imap grid;       /* hashed cell -> newest point in it (others chained through next) */
     int32_t *next;
     double *p;          /* 3 per point */
     int32_t n, cap;
     /* every query so far, by its exact coordinates, and its answer: most queries repeat one
      * exactly, and a repeated query has the same answer (points only ever get added, with higher
      * indices than any earlier answer) */
-    imap seen;          /* hash of the bits -> newest query with that hash */
+    fs_imap seen;       /* hash of the bits -> newest query with that hash */
     double *q;          /* 3 per query */
     int32_t *q_answer, *q_next;
     int32_t n_q, cap_q;
@@ -120,7 +45,7 @@ typedef struct {
 
 static uint64_t cell_key(long long x, long long y, long long z)
 {
-    return mix64(mix64(mix64((uint64_t)x) ^ (uint64_t)y) ^ (uint64_t)z);
+    return fs_mix64(fs_mix64(fs_mix64((uint64_t)x) ^ (uint64_t)y) ^ (uint64_t)z);
 }
 
 /* period may be NULL (no periodic axis). */
@@ -139,16 +64,16 @@ static void welder_init(welder *w, double tol, const double *period, size_t expe
             w->cell[q] = w->period[q] / (double)w->n_cells[q];
         }
     }
-    imap_init(&w->grid, expect);
-    imap_init(&w->seen, expect);
+    fs_imap_init(&w->grid, expect);
+    fs_imap_init(&w->seen, expect);
 }
 
 static void welder_free(welder *w)
 {
-    imap_free(&w->grid);
+    fs_imap_free(&w->grid);
     free(w->next);
     free(w->p);
-    imap_free(&w->seen);
+    fs_imap_free(&w->seen);
     free(w->q);
     free(w->q_answer);
     free(w->q_next);
@@ -181,7 +106,7 @@ static int32_t weld_search(welder *w, const double *x)
             for (int dx = 0; dx <= (side[0] != 0); dx++) {
                 uint64_t key = cell_key(wrap_cell(w, 0, c[0] + dx * side[0]), wrap_cell(w, 1, c[1] + dy * side[1]),
                                         wrap_cell(w, 2, c[2] + dz * side[2]));
-                const int32_t *head = imap_find(&w->grid, key);
+                const int32_t *head = fs_imap_find(&w->grid, key);
                 for (int32_t i = head ? *head : -1; i >= 0; i = w->next[i]) {
                     const double *p = w->p + 3 * (size_t)i;
                     double e2 = 0.0;
@@ -204,7 +129,7 @@ static int32_t weld_search(welder *w, const double *x)
     int32_t i = w->n++;
     memcpy(w->p + 3 * (size_t)i, x, 3 * sizeof *x);
     bool found;
-    int32_t *slot = imap_get(&w->grid, cell_key(wrap_cell(w, 0, c[0]), wrap_cell(w, 1, c[1]), wrap_cell(w, 2, c[2])), i,
+    int32_t *slot = fs_imap_get(&w->grid, cell_key(wrap_cell(w, 0, c[0]), wrap_cell(w, 1, c[1]), wrap_cell(w, 2, c[2])), i,
                              &found);
     w->next[i] = found ? *slot : -1;
     *slot = i;
@@ -217,10 +142,10 @@ static int32_t weld(welder *w, const double *x)
     for (int q = 0; q < 3; q++) {
         uint64_t bits;
         memcpy(&bits, x + q, sizeof bits);
-        h = mix64(h ^ bits);
+        h = fs_mix64(h ^ bits);
     }
     bool found;
-    int32_t *slot = imap_get(&w->seen, h, -1, &found);
+    int32_t *slot = fs_imap_get(&w->seen, h, -1, &found);
     for (int32_t i = *slot; i >= 0; i = w->q_next[i])
         if (!memcmp(w->q + 3 * (size_t)i, x, 3 * sizeof *x))
             return w->q_answer[i];
@@ -242,7 +167,7 @@ static int32_t weld(welder *w, const double *x)
 
 typedef struct {
     int dim;
-    imap table;     /* hash of the bits -> newest tuple with that hash */
+    fs_imap table;  /* hash of the bits -> newest tuple with that hash */
     int32_t *next;
     float *v;
     int32_t n, cap;
@@ -252,7 +177,7 @@ static void dedup_init(dedup *d, int dim, size_t expect)
 {
     memset(d, 0, sizeof *d);
     d->dim = dim;
-    imap_init(&d->table, expect);
+    fs_imap_init(&d->table, expect);
 }
 
 static int32_t dedup_add(dedup *d, const float *x)
@@ -261,10 +186,10 @@ static int32_t dedup_add(dedup *d, const float *x)
     for (int q = 0; q < d->dim; q++) {
         uint32_t bits;
         memcpy(&bits, x + q, sizeof bits);
-        h = mix64(h ^ bits);
+        h = fs_mix64(h ^ bits);
     }
     bool found;
-    int32_t *slot = imap_get(&d->table, h, -1, &found);
+    int32_t *slot = fs_imap_get(&d->table, h, -1, &found);
     for (int32_t i = *slot; i >= 0; i = d->next[i])
         if (!memcmp(d->v + (size_t)d->dim * (size_t)i, x, (size_t)d->dim * sizeof *x))
             return i;
@@ -305,9 +230,9 @@ typedef struct {
     bool wrap[2];
     double ext[2];       /* extents of the texture square in cm, for the canonical weld */
     welder canon;        /* canonical points: (u ext_x, v ext_y, 0), periodic on wrapping axes */
-    imap cut_map[4];     /* (lower id, higher id) of an edge -> its cut by a line of constant u (0, 1)
-                          * or v (2, 3); on a wrapping axis every line is one (0 or 2), on another
-                          * the lines 0 and 1 differ */
+    fs_imap cut_map[4];  /* (lower id, higher id) of an edge -> its cut by a line of constant u (0, 1)
+                       * or v (2, 3); on a wrapping axis every line is one (0 or 2), on another
+                       * the lines 0 and 1 differ */
     cut_point *cuts;
     int32_t n_cuts, cap_cuts;
     welder pos, base;
@@ -349,7 +274,7 @@ static uvh cut(lift_ctx *c, const uvh *a, const uvh *b, int axis, double line)
     double *along = axis ? &x.u : &x.v;
     bool found;
     int map = 2 * axis + (!c->wrap[axis] && line > 0.5);
-    int32_t *slot = imap_get(&c->cut_map[map], pair_key(a->id, b->id), c->n_cuts, &found);
+    int32_t *slot = fs_imap_get(&c->cut_map[map], pair_key(a->id, b->id), c->n_cuts, &found);
     if (!found) {
         FS_ARRAY_RESERVE(c->cuts, c->cap_cuts, c->n_cuts + 1, 256);
         if (axis)
@@ -497,7 +422,7 @@ typedef struct {
 } edge_rec;
 
 typedef struct {
-    imap map;
+    fs_imap map;
     edge_rec *e;
     int32_t n;
     int32_t *face_edge; /* 3 per triangle: its edges, corner k to k + 1 */
@@ -506,7 +431,7 @@ typedef struct {
 /* Records every edge of the first n_t triangles (positions as currently oriented). */
 static void edges_build(edge_table *et, const tri *t, int32_t n_t)
 {
-    imap_init(&et->map, 3 * (size_t)n_t / 2 + 16);
+    fs_imap_init(&et->map, 3 * (size_t)n_t / 2 + 16);
     et->e = fs_malloc((3 * (size_t)n_t + 1) * sizeof *et->e);
     et->face_edge = fs_malloc((3 * (size_t)n_t + 1) * sizeof *et->face_edge);
     et->n = 0;
@@ -515,7 +440,7 @@ static void edges_build(edge_table *et, const tri *t, int32_t n_t)
             int32_t a = t[f].pos[k], b = t[f].pos[(k + 1) % 3];
             int32_t lo = a < b ? a : b, hi = a < b ? b : a;
             bool found;
-            int32_t *slot = imap_get(&et->map, pair_key(lo, hi), et->n, &found);
+            int32_t *slot = fs_imap_get(&et->map, pair_key(lo, hi), et->n, &found);
             if (!found)
                 et->e[et->n++] = (edge_rec){lo, hi, {f, -1}, {(int8_t)k, -1}, 0};
             et->face_edge[3 * f + k] = *slot;
@@ -530,7 +455,7 @@ static void edges_build(edge_table *et, const tri *t, int32_t n_t)
 
 static void edges_free(edge_table *et)
 {
-    imap_free(&et->map);
+    fs_imap_free(&et->map);
     free(et->e);
     free(et->face_edge);
 }
@@ -695,18 +620,18 @@ static void close_steps(lift_ctx *c)
     }
     edges_free(&et);
 
-    imap by_base;
-    imap_init(&by_base, (size_t)n_h);
+    fs_imap by_base;
+    fs_imap_init(&by_base, (size_t)n_h);
     int32_t *count = fs_calloc((size_t)n_h + 1, sizeof *count);
     for (int32_t i = 0; i < n_h; i++) {
         bool found;
-        int32_t *slot = imap_get(&by_base, pair_key(c->pos_base[h[i].a], c->pos_base[h[i].b]), i, &found);
+        int32_t *slot = fs_imap_get(&by_base, pair_key(c->pos_base[h[i].a], c->pos_base[h[i].b]), i, &found);
         count[*slot]++;
     }
     int32_t n_before = c->n_t;
     for (int32_t i = 0; i < n_h; i++) {
         int32_t A = c->pos_base[h[i].a], B = c->pos_base[h[i].b];
-        const int32_t *mine = imap_find(&by_base, pair_key(A, B)), *other = imap_find(&by_base, pair_key(B, A));
+        const int32_t *mine = fs_imap_find(&by_base, pair_key(A, B)), *other = fs_imap_find(&by_base, pair_key(B, A));
         if (!other || count[*mine] != 1 || count[*other] != 1 || *other < i)
             continue;
         const half_edge *e = h + i, *p = h + *other;
@@ -719,7 +644,7 @@ static void close_steps(lift_ctx *c)
             push_tri(c, w2);
     }
     fs_debug("lift: %d boundary edges, %d wall triangles added", (int)n_h, (int)(c->n_t - n_before));
-    imap_free(&by_base);
+    fs_imap_free(&by_base);
     free(count);
     free(h);
 }
@@ -734,8 +659,8 @@ static int32_t split_columns(lift_ctx *c)
 {
     edge_table et;
     edges_build(&et, c->t, c->n_t);
-    imap column;                 /* base point -> newest entry of its list */
-    imap_init(&column, 64);
+    fs_imap column;              /* base point -> newest entry of its list */
+    fs_imap_init(&column, 64);
     int32_t *col_vertex = NULL, *col_next = NULL, n_col = 0;
     int32_t *edges = NULL, n_edges = 0; /* face * 3 + corner of each vertical boundary edge */
     for (int32_t i = 0; i < et.n; i++) {
@@ -747,7 +672,7 @@ static int32_t split_columns(lift_ctx *c)
         int32_t ends[2] = {r->a, r->b};
         for (int q = 0; q < 2; q++) {
             bool found;
-            int32_t *slot = imap_get(&column, (uint64_t)c->pos_base[ends[q]], -1, &found);
+            int32_t *slot = fs_imap_get(&column, (uint64_t)c->pos_base[ends[q]], -1, &found);
             col_vertex = fs_realloc(col_vertex, (size_t)(n_col + 1) * sizeof *col_vertex);
             col_next = fs_realloc(col_next, (size_t)(n_col + 1) * sizeof *col_next);
             col_vertex[n_col] = ends[q];
@@ -772,7 +697,7 @@ static int32_t split_columns(lift_ctx *c)
         int32_t mid[16];
         double at[16];
         int n_mid = 0;
-        for (int32_t j = *imap_find(&column, (uint64_t)c->pos_base[a]); j >= 0 && n_mid < 16; j = col_next[j]) {
+        for (int32_t j = *fs_imap_find(&column, (uint64_t)c->pos_base[a]); j >= 0 && n_mid < 16; j = col_next[j]) {
             int32_t v = col_vertex[j];
             double am[3];
             fs_sub3(am, c->pos.p + 3 * (size_t)v, pa);
@@ -813,7 +738,7 @@ static int32_t split_columns(lift_ctx *c)
     }
     fs_debug("lift: %d vertical boundary edges, %d split into %d triangles", (int)n_edges, (int)splits,
              (int)(c->n_t - n_before + splits));
-    imap_free(&column);
+    fs_imap_free(&column);
     free(col_vertex);
     free(col_next);
     free(edges);
@@ -1124,7 +1049,7 @@ int fs_render_lift(const fs_surface *m, const fs_domain *dom, double height_scal
     double period[3] = {c.wrap[0] ? c.ext[0] : 0.0, c.wrap[1] ? c.ext[1] : 0.0, 0.0};
     welder_init(&c.canon, tol, period, (size_t)m->n_verts);
     for (int k = 0; k < 4; k++)
-        imap_init(&c.cut_map[k], 64);
+        fs_imap_init(&c.cut_map[k], 64);
     welder_init(&c.pos, tol, NULL, (size_t)m->n_verts);
     welder_init(&c.base, tol, NULL, (size_t)m->n_verts);
     dedup_init(&c.uv, 2, (size_t)m->n_verts);
@@ -1166,11 +1091,11 @@ int fs_render_lift(const fs_surface *m, const fs_domain *dom, double height_scal
 
     welder_free(&c.canon);
     for (int k = 0; k < 4; k++)
-        imap_free(&c.cut_map[k]);
+        fs_imap_free(&c.cut_map[k]);
     free(c.cuts);
     welder_free(&c.pos);
     welder_free(&c.base);
-    imap_free(&c.uv.table);
+    fs_imap_free(&c.uv.table);
     free(c.uv.next);
     free(c.pos_base);
     free(c.memo_pos);
@@ -1209,7 +1134,7 @@ int fs_render_solid(const fs_solid *s, fs_lifted_mesh *out)
     out->n_pos = s->n_pos;
     out->pos = fs_malloc((3 * (size_t)s->n_pos + 1) * sizeof *out->pos);
     memcpy(out->pos, s->pos, 3 * (size_t)s->n_pos * sizeof *out->pos);
-    imap_free(&c.uv.table);
+    fs_imap_free(&c.uv.table);
     free(c.uv.next);
     free(c.t);
     return 0;
@@ -1230,8 +1155,8 @@ void fs_lifted_mesh_free(fs_lifted_mesh *l)
 int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges, int32_t *n_bad)
 {
     *edges = NULL;
-    imap map;
-    imap_init(&map, 3 * (size_t)l->n_tris / 2 + 16);
+    fs_imap map;
+    fs_imap_init(&map, 3 * (size_t)l->n_tris / 2 + 16);
     /* per undirected edge: the directed edge of its first triangle and how many triangles use it */
     int32_t *first = fs_malloc((6 * (size_t)l->n_tris + 2) * sizeof *first);
     int32_t *count = fs_calloc(3 * (size_t)l->n_tris + 1, sizeof *count);
@@ -1241,7 +1166,7 @@ int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges, int32_
         for (int k = 0; k < 3; k++) {
             int32_t a = l->corner[9 * (size_t)f + 3 * k], b = l->corner[9 * (size_t)f + 3 * ((k + 1) % 3)];
             bool found;
-            int32_t *slot = imap_get(&map, pair_key(a < b ? a : b, a < b ? b : a), n, &found);
+            int32_t *slot = fs_imap_get(&map, pair_key(a < b ? a : b, a < b ? b : a), n, &found);
             if (!found) {
                 first[2 * n] = a;
                 first[2 * n + 1] = b;
@@ -1266,7 +1191,7 @@ int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges, int32_
             j++;
         }
     *edges = e;
-    imap_free(&map);
+    fs_imap_free(&map);
     free(first);
     free(count);
     free(twice);
@@ -1275,8 +1200,8 @@ int32_t fs_lifted_mesh_boundary(const fs_lifted_mesh *l, int32_t **edges, int32_
 
 int32_t fs_lifted_mesh_vertices(const fs_lifted_mesh *l, int32_t **vert, uint32_t **tris)
 {
-    imap map;
-    imap_init(&map, (size_t)l->n_pos);
+    fs_imap map;
+    fs_imap_init(&map, (size_t)l->n_pos);
     int32_t *v = fs_malloc((9 * (size_t)l->n_tris + 3) * sizeof *v);
     int32_t *next = fs_malloc((3 * (size_t)l->n_tris + 1) * sizeof *next);
     uint32_t *t = fs_malloc((3 * (size_t)l->n_tris + 1) * sizeof *t);
@@ -1284,8 +1209,8 @@ int32_t fs_lifted_mesh_vertices(const fs_lifted_mesh *l, int32_t **vert, uint32_
     for (size_t k = 0; k < 3 * (size_t)l->n_tris; k++) {
         const int32_t *c = l->corner + 3 * k;
         bool found;
-        uint64_t key = mix64(mix64(mix64((uint64_t)c[0]) ^ (uint64_t)c[1]) ^ (uint64_t)c[2]);
-        int32_t *slot = imap_get(&map, key, -1, &found);
+        uint64_t key = fs_mix64(fs_mix64(fs_mix64((uint64_t)c[0]) ^ (uint64_t)c[1]) ^ (uint64_t)c[2]);
+        int32_t *slot = fs_imap_get(&map, key, -1, &found);
         int32_t i = *slot;
         while (i >= 0 && memcmp(v + 3 * (size_t)i, c, 3 * sizeof *c))
             i = next[i];
@@ -1297,7 +1222,7 @@ int32_t fs_lifted_mesh_vertices(const fs_lifted_mesh *l, int32_t **vert, uint32_
         }
         t[k] = (uint32_t)i;
     }
-    imap_free(&map);
+    fs_imap_free(&map);
     free(next);
     *vert = v;
     *tris = t;

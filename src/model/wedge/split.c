@@ -5,6 +5,7 @@
 
 #include "base/array.h"
 #include "base/error.h"
+#include "base/imap.h"
 #include "base/uf.h"
 #include "base/vec.h"
 #include "fracture/eigen.h"
@@ -243,7 +244,7 @@ static const uint8_t *open_nodes(fs_wedge_model *w)
 {
     const fs_mesh *m = w->mesh;
     if (!w->open_valid) {
-        w->open = fs_realloc(w->open, (size_t)m->n_nodes + 1);
+        FS_ASSERT(m->n_nodes == w->n_nodes); /* w->open has the per-node arrays' room */
         memset(w->open, 0, (size_t)m->n_nodes + 1);
         for (int32_t h = 0; h < 3 * m->n_tris; h++)
             if (m->adj[h] < 0) {
@@ -259,7 +260,6 @@ void fs_wedge_open_update(fs_wedge_model *w, const int32_t *nodes, int32_t n)
 {
     if (!w->open_valid)
         return;
-    w->open = fs_realloc(w->open, (size_t)w->n_nodes + 1);
     for (int32_t q = 0; q < n; q++)
         w->open[nodes[q]] = node_open(w, nodes[q]);
 #ifdef FS_VALIDATE
@@ -395,44 +395,12 @@ static void ilist_push(ilist *l, int32_t x)
     l->v[l->n++] = x;
 }
 
-/* A set of indices (open addressing, at most half full): what a list's search would answer in time
- * proportional to its length. */
-typedef struct {
-    int32_t *slot; /* -1: empty */
-    int32_t mask, n;
-} iset;
-
-static bool iset_insert(iset *s, int32_t x);
-
-static void iset_grow(iset *s)
+/* Adds x to the set (the keys of m); true if it was not in it. */
+static bool set_insert(fs_imap *m, int32_t x)
 {
-    iset old = *s;
-    int32_t size = old.slot ? 2 * (old.mask + 1) : 64;
-    s->slot = fs_malloc((size_t)size * sizeof *s->slot);
-    for (int32_t k = 0; k < size; k++)
-        s->slot[k] = -1;
-    s->mask = size - 1;
-    s->n = 0;
-    for (int32_t k = 0; old.slot && k <= old.mask; k++)
-        if (old.slot[k] >= 0)
-            iset_insert(s, old.slot[k]);
-    free(old.slot);
-}
-
-/* Adds x (>= 0); true if it was not in the set. */
-static bool iset_insert(iset *s, int32_t x)
-{
-    if (!s->slot || 2 * (s->n + 1) > s->mask + 1)
-        iset_grow(s);
-    for (uint32_t k = ((uint32_t)x * 2654435761u) & (uint32_t)s->mask;; k = (k + 1) & (uint32_t)s->mask) {
-        if (s->slot[k] == x)
-            return false;
-        if (s->slot[k] < 0) {
-            s->slot[k] = x;
-            s->n++;
-            return true;
-        }
-    }
+    bool found;
+    fs_imap_get(m, (uint64_t)x, 0, &found);
+    return !found;
 }
 
 /* ---- the cut (the mesh surgery itself is geom/cut.h's) ---- */
@@ -733,27 +701,29 @@ static void tip_average_plane(fs_wedge_model *w, int32_t i, const double ahead[3
     double radius = w->cfg.fracture.direction_radius * fs_wedge_tips_unit(w);
     const double *tip = mesh->pos + 3 * (size_t)i;
     ilist nodes = {0}, elems = {0};
-    iset node_set = {0}, elem_set = {0};
+    fs_imap node_set, elem_set;
+    fs_imap_init(&node_set, 64);
+    fs_imap_init(&elem_set, 64);
     ilist_push(&nodes, i);
-    iset_insert(&node_set, i);
+    set_insert(&node_set, i);
     for (int32_t q = 0; q < nodes.n; q++) {
         int32_t v = nodes.v[q];
         for (int32_t p = w->node_elem_start[v]; p < w->node_elem_start[v] + w->node_elem_count[v]; p++) {
             int32_t e = w->node_elem[p];
-            if (w->state[e] != FS_WEDGE_ALIVE || !iset_insert(&elem_set, e))
+            if (w->state[e] != FS_WEDGE_ALIVE || !set_insert(&elem_set, e))
                 continue;
             ilist_push(&elems, e);
             for (int c = 0; c < 3; c++) {
                 int32_t j = mesh->tri[3 * (size_t)e + c];
                 double d[3];
                 fs_domain_delta(&mesh->domain, tip, mesh->pos + 3 * (size_t)j, d);
-                if (fs_norm3(d) <= 3.0 * radius && iset_insert(&node_set, j))
+                if (fs_norm3(d) <= 3.0 * radius && set_insert(&node_set, j))
                     ilist_push(&nodes, j);
             }
         }
     }
-    free(node_set.slot);
-    free(elem_set.slot);
+    fs_imap_free(&node_set);
+    fs_imap_free(&elem_set);
     const stresses st = {w->stress_top, NULL, 0.0};
     fs_tip_stress avg;
     fs_tip_stress_begin(&avg, ahead, w->normal + 3 * (size_t)i, radius);

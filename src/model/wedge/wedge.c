@@ -178,6 +178,7 @@ void fs_wedge_grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems)
         FS_ARRAY_RESIZE(w->node_elem_count, nn);
         FS_ARRAY_RESIZE(w->node_ratio, nn);
         FS_ARRAY_RESIZE(w->node_ratio_exact, nn);
+        FS_ARRAY_RESIZE(w->open, nn + 1);
     }
     size_t old_cap = (size_t)w->elem_cap;
     if (grow_capacity(&w->elem_cap, n_elems)) {
