@@ -85,8 +85,10 @@ static void scale_guess(fs_wedge_model *w)
  * is dropped (fs_wedge_apply_change); re-analysing and re-factorizing it for each global solve cost
  * 5-10 times a conjugate-gradient solve started from the current displacements, which are close to
  * the answer (the layer is well conditioned: every wedge's bottom is held). So a global solve with
- * a stale factor is done by CG to solver.tolerance; the factor is rebuilt only when the mesh has not
- * changed since (fs_wedge_refactor). */
+ * a stale factor is done by CG to solver.tolerance. The factor is made again only by a refill at a
+ * new thickness (fs_wedge_refill_system), by the fallback below, or on request (fs_wedge_refactor).
+ * Even on bark-l, whose CG solves take about 100 iterations, analysing and factorizing at every
+ * global solve instead cost 7.4 s against CG's 6.4 s. */
 static int solve(fs_wedge_model *w)
 {
     double t0 = fs_seconds();
