@@ -349,6 +349,9 @@ static void test_probe(void)
         {"WebP, lossless", BYTES('R', 'I', 'F', 'F', 30, 0, 0, 0, 'W', 'E', 'B', 'P', 'V', 'P', '8', 'L', 10, 0, 0, 0,
                                  0x2f, 0x7f, 0xc2, 0x77, 0),
          "WebP", 640, 480},
+        {"P7 without white space after it", BYTES('P', '7', 'W', '\n', 'W', 'I', 'D', 'T', 'H', ' ', '8', '\n'),
+         NULL, 0, 0},
+        {"P5 without white space after it", BYTES('P', '5', '6', '4', ' ', '4', '8', '\n'), NULL, 0, 0},
         {"GIF", BYTES('G', 'I', 'F', '8', '9', 'a', 1, 0, 1, 0), NULL, 0, 0},
         {"empty", (const unsigned char *)"", 0, NULL, 0, 0},
     };
@@ -408,6 +411,31 @@ static void test_pixel_limits(void)
     fs_error_clear();
     CHECK(fs_image_decode_grey((const unsigned char *)"GIF89a", 6, "a.gif", &w, &h, &g) == -1);
     CHECK_MSG(strstr(fs_error_message(), "a.gif: not an image fissure reads") != NULL, "%s", fs_error_message());
+}
+
+/* Bytes that OpenCV would hand to another decoder than the one fissure checked the header of are
+ * refused before decoding. The fuzzer found a "P7" file without white space after the magic number
+ * (which OpenCV's PNM readers do not claim) and with DICM at byte 128: OpenCV gave it to its DICOM
+ * reader, which aborted the process. */
+static void test_decoder_mismatch(void)
+{
+    int w = 0, h = 0;
+    float *g = NULL;
+    unsigned char pam[160] = "P7W!\nWIDTH 8\nHEIGHT 24\nDEPTH 1\nMAXVAL 255\nENDHDR\n";
+    memcpy(pam + 128, "DICM", 4);
+    fs_error_clear();
+    CHECK(fs_image_decode_grey(pam, sizeof pam, "odd.pam", &w, &h, &g) == -1 && g == NULL);
+    CHECK(fs_error_domain() == FS_ERR_DATA);
+    CHECK_MSG(strstr(fs_error_message(), "odd.pam: not an image fissure reads") != NULL, "%s", fs_error_message());
+    /* a header fissure reads (WebP, lossless) with DICM at byte 128 */
+    unsigned char webp[160] = {'R', 'I', 'F', 'F', 152, 0, 0, 0, 'W', 'E', 'B', 'P', 'V', 'P', '8', 'L', 140, 0, 0, 0,
+                               0x2f, 0x7f, 0xc2, 0x77, 0};
+    memcpy(webp + 128, "DICM", 4);
+    fs_error_clear();
+    CHECK(fs_image_decode_grey(webp, sizeof webp, "odd.webp", &w, &h, &g) == -1 && g == NULL);
+    CHECK(fs_error_domain() == FS_ERR_DATA);
+    CHECK_MSG(!strcmp(fs_error_message(), "odd.webp: a WebP header with a DICOM marker (DICM at byte 128): refused"),
+              "%s", fs_error_message());
 }
 
 /* A decoder's complaint is part of fissure's message (it printed "libpng error: ..." on stderr
@@ -470,6 +498,7 @@ int main(void)
     RUN(test_srgb_tag);
     RUN(test_probe);
     RUN(test_pixel_limits);
+    RUN(test_decoder_mismatch);
     RUN(test_decoder_message);
     remove_tmpdir();
     return check_finish();

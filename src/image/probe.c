@@ -1,6 +1,7 @@
 /* Image headers: the format and the size of an image file from its bytes, before any decoder runs. */
 #include "image/image.h"
 
+#include <stdbool.h>
 #include <string.h>
 
 static uint32_t be16(const unsigned char *p) { return (uint32_t)p[0] << 8 | p[1]; }
@@ -131,12 +132,17 @@ static int probe_exr(const unsigned char *d, size_t n, fs_image_header *out)
     return found(out, "OpenEXR", 0, 0);
 }
 
+/* PNM white space: that of C's isspace in the C locale. */
+static bool pnm_space(unsigned char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
+}
+
 /* A decimal field of a PNM header after white space and # comments; -1 when there is none. */
 static int64_t pnm_number(const unsigned char *d, size_t n, size_t *p)
 {
     for (;;) {
-        while (*p < n && (d[*p] == ' ' || d[*p] == '\t' || d[*p] == '\n' || d[*p] == '\r' || d[*p] == '\v' ||
-                          d[*p] == '\f'))
+        while (*p < n && pnm_space(d[*p]))
             (*p)++;
         if (*p < n && d[*p] == '#') {
             while (*p < n && d[*p] != '\n')
@@ -212,7 +218,10 @@ int fs_image_probe(const unsigned char *data, size_t n, fs_image_header *out)
         return probe_tiff(data, n, out);
     if (n >= 8 && !memcmp(data, "\x76\x2f\x31\x01", 4))
         return probe_exr(data, n, out);
-    if (n >= 3 && data[0] == 'P' && ((data[1] >= '1' && data[1] <= '7') || data[1] == 'F' || data[1] == 'f'))
+    /* the white space after the magic number is part of the PNM signature for OpenCV's decoders too:
+     * without it they leave the bytes to the next decoder that claims them */
+    if (n >= 3 && data[0] == 'P' && ((data[1] >= '1' && data[1] <= '7') || data[1] == 'F' || data[1] == 'f') &&
+        pnm_space(data[2]))
         return probe_pnm(data, n, out);
     if (n >= 16 && !memcmp(data, "RIFF", 4) && !memcmp(data + 8, "WEBP", 4))
         return probe_webp(data, n, out);
