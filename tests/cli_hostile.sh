@@ -67,6 +67,13 @@ expect_status 65 "a corrupt PNG map: exit 65" "$FISSURE" -q -o "$tmp/map" --size
 grep -q "^fissure: .*broken.png: cannot decode the PNG image: libpng error: " "$tmp/stderr" \
     && ok "the decoder's complaint is in fissure's message" || { not_ok "the decoder's complaint is in fissure's message"; head -3 "$tmp/stderr"; }
 grep -v -q '^fissure: ' "$tmp/stderr" && not_ok "no raw decoder line on stderr" || ok "no raw decoder line on stderr"
+# Bytes that only look like a PNM header (no white space after P7) with DICM at byte 128: OpenCV's
+# PNM readers do not claim them and its DICOM reader did, aborting the process (the fuzzer's find).
+expect_status 65 "a P7 file without white space and with a DICOM marker: exit 65" "$FISSURE" -q -o "$tmp/map" \
+    --size 32x32 --set mesh.elements=200 \
+    --set material.threshold_map="$top_srcdir/tests/fuzz/greymap-seeds/pam-dicm" "$PRESETS/heart.ini"
+grep -q "pam-dicm: not an image fissure reads" "$tmp/stderr" \
+    && ok "it is not an image fissure reads" || { not_ok "it is not an image fissure reads"; head -3 "$tmp/stderr"; }
 if mkfifo "$tmp/map.png"; then
     bounded 10 66 "a FIFO as a map: exit 66" "$FISSURE" -q -o "$tmp/map" --size 32x32 --set mesh.elements=200 \
         --set material.threshold_map="$tmp/map.png" "$PRESETS/heart.ini"
