@@ -266,7 +266,7 @@ static int decode_bytes(const std::vector<unsigned char> &bytes, const char *ori
     /* OpenCV hands bytes whose own decoder does not claim them to the next one that does, and its
      * DICOM reader (GDCM) claims anything with DICM at byte 128 and aborts the process on a bad file */
     if (bytes.size() >= 132 && !memcmp(bytes.data() + 128, "DICM", 4)) {
-        fs_error(FS_ERR_DATA, "%s: a %s header with a DICOM marker (DICM at byte 128): refused", origin, h.format);
+        fs_error(FS_ERR_DATA, "%s: %s header with a DICOM marker (DICM at byte 128): refused", origin, h.format);
         return -1;
     }
     if (h.width > FS_IMAGE_MAX_PIXELS || h.height > FS_IMAGE_MAX_PIXELS || h.width * h.height > max_pixels) {
