@@ -43,7 +43,8 @@ typedef struct {
     int32_t n_q, cap_q;
 } welder;
 
-static uint64_t cell_key(long long x, long long y, long long z)
+/* A hash key of three integers: a grid cell's indices, or a corner's three ids. */
+static uint64_t triple_key(long long x, long long y, long long z)
 {
     return fs_mix64(fs_mix64(fs_mix64((uint64_t)x) ^ (uint64_t)y) ^ (uint64_t)z);
 }
@@ -104,8 +105,9 @@ static int32_t weld_search(welder *w, const double *x)
     for (int dz = 0; dz <= (side[2] != 0); dz++)
         for (int dy = 0; dy <= (side[1] != 0); dy++)
             for (int dx = 0; dx <= (side[0] != 0); dx++) {
-                uint64_t key = cell_key(wrap_cell(w, 0, c[0] + dx * side[0]), wrap_cell(w, 1, c[1] + dy * side[1]),
-                                        wrap_cell(w, 2, c[2] + dz * side[2]));
+                uint64_t key = triple_key(wrap_cell(w, 0, c[0] + dx * side[0]),
+                                          wrap_cell(w, 1, c[1] + dy * side[1]),
+                                          wrap_cell(w, 2, c[2] + dz * side[2]));
                 const int32_t *head = fs_imap_find(&w->grid, key);
                 for (int32_t i = head ? *head : -1; i >= 0; i = w->next[i]) {
                     const double *p = w->p + 3 * (size_t)i;
@@ -129,8 +131,8 @@ static int32_t weld_search(welder *w, const double *x)
     int32_t i = w->n++;
     memcpy(w->p + 3 * (size_t)i, x, 3 * sizeof *x);
     bool found;
-    int32_t *slot = fs_imap_get(&w->grid, cell_key(wrap_cell(w, 0, c[0]), wrap_cell(w, 1, c[1]), wrap_cell(w, 2, c[2])), i,
-                             &found);
+    uint64_t key = triple_key(wrap_cell(w, 0, c[0]), wrap_cell(w, 1, c[1]), wrap_cell(w, 2, c[2]));
+    int32_t *slot = fs_imap_get(&w->grid, key, i, &found);
     w->next[i] = found ? *slot : -1;
     *slot = i;
     return i;
@@ -231,8 +233,8 @@ typedef struct {
     double ext[2];       /* extents of the texture square in cm, for the canonical weld */
     welder canon;        /* canonical points: (u ext_x, v ext_y, 0), periodic on wrapping axes */
     fs_imap cut_map[4];  /* (lower id, higher id) of an edge -> its cut by a line of constant u (0, 1)
-                       * or v (2, 3); on a wrapping axis every line is one (0 or 2), on another
-                       * the lines 0 and 1 differ */
+                          * or v (2, 3); on a wrapping axis every line is one (0 or 2), on another
+                          * the lines 0 and 1 differ */
     cut_point *cuts;
     int32_t n_cuts, cap_cuts;
     welder pos, base;
@@ -1209,7 +1211,7 @@ int32_t fs_lifted_mesh_vertices(const fs_lifted_mesh *l, int32_t **vert, uint32_
     for (size_t k = 0; k < 3 * (size_t)l->n_tris; k++) {
         const int32_t *c = l->corner + 3 * k;
         bool found;
-        uint64_t key = fs_mix64(fs_mix64(fs_mix64((uint64_t)c[0]) ^ (uint64_t)c[1]) ^ (uint64_t)c[2]);
+        uint64_t key = triple_key(c[0], c[1], c[2]);
         int32_t *slot = fs_imap_get(&map, key, -1, &found);
         int32_t i = *slot;
         while (i >= 0 && memcmp(v + 3 * (size_t)i, c, 3 * sizeof *c))

@@ -292,11 +292,12 @@ static void heap_down(bound_entry *h, int32_t n, int32_t i)
  * stresses, wedge/split.c, and leaves the element ratios as bounds), so the shared eigen kernel runs
  * only on the elements whose upper bound (fs_eigen_principal_bound) could reach the largest exact
  * ratio, in descending order of the bound, until the next bound falls below the best exact ratio
- * found (less the tie tolerance). Every other ratio holds its bound. Where the layer holds many elements over 1
- * that do not break (Griffith's criterion stops cracks), the candidates come off a binary heap, in
- * the same order as a sort, which would cost n log n at every call for the few that are needed; the
- * heap holds only the elements whose bound reaches the exact ratio of the first candidate (the
- * largest bound) less the tie tolerance, as no other could come off it before the search stops.
+ * found (less the tie tolerance). Every other ratio holds its bound. Where the layer holds many
+ * elements over 1 that do not break (Griffith's criterion stops cracks), the candidates come off a
+ * binary heap, in the same order as a sort, which would cost n log n at every call for the few that
+ * are needed; the heap holds only the elements whose bound reaches the exact ratio of the first
+ * candidate (the largest bound) less the tie tolerance, as no other could come off it before the
+ * search stops.
  * With lazy_ratios, an element evaluated before at the same shrinkage and eigenstrain is not evaluated
  * again while its old bound plus ratio_lipschitz times the change of its nodal displacements stays at
  * most LAZY_LEVEL: that sum bounds the exact ratio too. After a removal the displacements change
