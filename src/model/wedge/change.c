@@ -515,6 +515,7 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
 {
     double t0 = fs_seconds();
     int32_t n_free_old = w->n_free, n_fixed_old = w->n_fixed, n0 = c->n_nodes_before, e0 = c->n_tris_before;
+    bool synced = w->x_synced;
     fs_wedge_grow_arrays(w, w->mesh->n_nodes, w->mesh->n_tris);
     for (int32_t i = n0; i < w->n_nodes; i++) {
         int32_t a = c->node_parent[2 * (i - n0)], b = c->node_parent[2 * (i - n0) + 1];
@@ -534,7 +535,7 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
         w->young[e] = w->young[parent];
         w->threshold[e] = w->threshold[parent];
     }
-    fs_wedge_number_dofs(w);
+    fs_wedge_number_appended(w);
     fs_wedge_update_node_elems(w, n0, e0, c->changed, c->n_changed, c->node_parent, 2 * (w->n_nodes - n0));
     int32_t n_changed = c->n_changed + (w->n_elems - e0);
     int32_t *changed = fs_malloc(((size_t)n_changed + 1) * sizeof *changed);
@@ -560,12 +561,8 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
         rc = fs_wedge_refresh_cache(w, changed, n_changed);
     if (rc == 0) /* the stresses of the changed elements at the displacements carried over */
         rc = fs_wedge_element_ratios(w, changed, n_changed);
-    for (int32_t i = 0; i < w->n_nodes && rc == 0; i++)
-        for (int l = 3; l < 6; l++) {
-            int32_t g = w->dof[6 * (size_t)i + l];
-            if (g < w->n_free)
-                w->x[g] = w->u[6 * (size_t)i + l];
-        }
+    if (rc == 0) /* the nodes that kept their unknowns and displacements have them in x already */
+        fs_wedge_sync_x(w, synced ? (w->dof_kept_nodes < n0 ? w->dof_kept_nodes : n0) : 0);
     free(changed);
     free(nodes);
     w->counters.assemble_seconds += fs_seconds() - t0;

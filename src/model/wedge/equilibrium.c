@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "base/threads.h"
@@ -19,26 +20,33 @@
 
 /* ---- equilibrium ---- */
 
-/* Displacement of the fixed DOFs at time t: the prescribed values plus the growth motion of the
- * bottom nodes (moving mode). */
-static void fixed_displacements(fs_wedge_model *w, double t)
+/* Displacement at time t of node i's fixed DOFs of fixed index `from` on: the prescribed value plus,
+ * for the bottom node, its growth motion (moving mode). */
+static void fixed_node(fs_wedge_model *w, int32_t i, double t, int32_t from)
 {
-    const fs_mesh *m = w->mesh;
-    for (int32_t j = 0; j < w->n_fixed; j++) {
-        int32_t nd = w->fixed_node_dof[j];
-        w->u_fixed[j] = w->prescribed[nd];
-    }
-    if (w->growth_mode != FS_WEDGE_GROWTH_MOVE)
-        return;
-    for (int32_t i = 0; i < w->n_nodes; i++) {
-        const double *p = m->pos + 3 * (size_t)i;
-        double q[3];
+    const double *p = w->mesh->pos + 3 * (size_t)i;
+    double q[3];
+    bool move = w->growth_mode == FS_WEDGE_GROWTH_MOVE;
+    if (move)
         fs_growth_flow(&w->growth, p, 0.0, t, q);
-        for (int k = 0; k < 3; k++) {
-            int32_t g = w->dof[6 * (size_t)i + k];
-            w->u_fixed[g - w->n_free] += q[k] - p[k];
-        }
+    for (int l = 0; l < 6; l++) {
+        int32_t j = w->dof[6 * (size_t)i + l] - w->n_free; /* negative: free */
+        if (j < from)
+            continue;
+        w->u_fixed[j] = w->prescribed[6 * (size_t)i + l];
+        if (move && l < 3)
+            w->u_fixed[j] += q[l] - p[l];
     }
+}
+
+/* The displacements of the fixed DOFs from the fixed index `from` on (the others untouched) at time
+ * t. A node's fixed DOFs follow those of the nodes before it (fs_wedge_number_dofs), so the nodes
+ * start at the one of index from. */
+static void fixed_displacements(fs_wedge_model *w, double t, int32_t from)
+{
+    for (int32_t i = from < w->n_fixed ? w->fixed_node_dof[from] / 6 : w->n_nodes; i < w->n_nodes; i++)
+        fixed_node(w, i, t, from);
+    w->n_fixed_moved = 0;
 }
 
 void fs_wedge_build_rhs(fs_wedge_model *w)
@@ -455,6 +463,7 @@ static void scatter_u(fs_wedge_model *w)
             int32_t g = w->dof[6 * (size_t)i + l];
             w->u[6 * (size_t)i + l] = g < w->n_free ? w->x[g] : w->u_fixed[g - w->n_free];
         }
+    w->x_synced = true;
 }
 
 int fs_wedge_equilibrium(fs_wedge_model *w, double t)
@@ -474,12 +483,16 @@ int fs_wedge_equilibrium(fs_wedge_model *w, double t)
         for (int k = 0; k < 3; k++)
             w->eigenstrain[k] = -v[k];
     }
-    fixed_displacements(w, t);
+    w->fixed_exact = 0; /* until u holds them too */
+    w->x_synced = false;
+    fixed_displacements(w, t, 0);
     fs_wedge_build_rhs(w);
     if ((w->factor_stale && w->cfg.solver.relax != FS_RELAX_LOCAL && fs_wedge_factorize(w, false) < 0) || solve(w) < 0)
         return -1;
     scatter_u(w);
     w->time = t;
+    w->fixed_time = t;
+    w->fixed_exact = w->n_fixed;
     int rc = fs_wedge_element_ratios(w, NULL, w->n_elems);
 #ifdef FS_VALIDATE
     if (rc == 0)
@@ -547,6 +560,7 @@ int fs_wedge_interpolate(fs_wedge_model *w, const fs_wedge_snapshot *a, const fs
         w->x[i] = a->x[i] + s * (b->x[i] - a->x[i]);
     for (int32_t j = 0; j < w->n_fixed; j++)
         w->u_fixed[j] = a->u_fixed[j] + s * (b->u_fixed[j] - a->u_fixed[j]);
+    w->fixed_exact = 0; /* a blend, not what fixed_displacements gives */
     scatter_u(w);
     w->time = t;
     return fs_wedge_element_ratios(w, NULL, w->n_elems);
@@ -557,12 +571,58 @@ int fs_wedge_update_ratios(fs_wedge_model *w, const int32_t *elems, int32_t n)
     return fs_wedge_element_ratios(w, elems, elems ? n : w->n_elems);
 }
 
+void fs_wedge_node_moved(fs_wedge_model *w, int32_t node)
+{
+    if (node >= w->n_nodes)
+        return; /* a node of the cut under way: its fixed DOFs are new */
+    FS_ARRAY_RESERVE(w->fixed_moved, w->cap_fixed_moved, w->n_fixed_moved + 1, 16);
+    w->fixed_moved[w->n_fixed_moved++] = node;
+}
+
+void fs_wedge_sync_x(fs_wedge_model *w, int32_t first)
+{
+    for (int32_t i = first; i < w->n_nodes; i++)
+        for (int l = 3; l < 6; l++) {
+            int32_t g = w->dof[6 * (size_t)i + l];
+            if (g < w->n_free)
+                w->x[g] = w->u[6 * (size_t)i + l];
+        }
+    w->x_synced = true;
+}
+
 void fs_wedge_prescribe_fixed(fs_wedge_model *w)
 {
-    fixed_displacements(w, w->time);
+    /* the fixed DOFs the model holds at this time already keep their values (a cut adds some and
+     * keeps the others' numbers): the same as computing them again, without a pass over the mesh */
+    int32_t from = w->fixed_time == w->time ? w->fixed_exact : 0;
+    for (int32_t q = 0; q < w->n_fixed_moved && from > 0; q++) { /* nodes a cut moved */
+        int32_t i = w->fixed_moved[q];
+        fixed_node(w, i, w->time, 0);
+        for (int l = 0; l < 6; l++) {
+            int32_t g = w->dof[6 * (size_t)i + l];
+            if (g >= w->n_free)
+                w->u[6 * (size_t)i + l] = w->u_fixed[g - w->n_free];
+        }
+    }
+    fixed_displacements(w, w->time, from);
     /* fixed_node_dof lists the node DOF of each fixed one (fs_wedge_number_dofs) */
-    for (int32_t j = 0; j < w->n_fixed; j++)
+    for (int32_t j = from; j < w->n_fixed; j++)
         w->u[w->fixed_node_dof[j]] = w->u_fixed[j];
+    w->fixed_time = w->time;
+    w->fixed_exact = w->n_fixed;
+#ifdef FS_VALIDATE
+    /* the kept values are those of computing all of them afresh, bit for bit */
+    double *kept = fs_malloc(((size_t)w->n_fixed + 1) * sizeof *kept);
+    memcpy(kept, w->u_fixed, (size_t)w->n_fixed * sizeof *kept);
+    fixed_displacements(w, w->time, 0);
+    for (int32_t j = 0; j < w->n_fixed; j++)
+        FS_INVARIANT(memcmp(&kept[j], &w->u_fixed[j], sizeof *kept) == 0 &&
+                         memcmp(&w->u[w->fixed_node_dof[j]], &kept[j], sizeof *kept) == 0,
+                     "wedge model at time %g: fixed DOF %d (node DOF %d) kept %.17g, u %.17g, afresh %.17g",
+                     w->time, (int)j, (int)w->fixed_node_dof[j], kept[j], w->u[w->fixed_node_dof[j]],
+                     w->u_fixed[j]);
+    free(kept);
+#endif
 }
 
 double fs_wedge_max_ratio(const fs_wedge_model *w)

@@ -203,6 +203,14 @@ struct fs_wedge_model {
     int32_t load_capacity;       /* free DOFs load has room for (it grows geometrically) */
     double *rhs, *x;             /* n_free each: the right-hand side and the free displacements */
     double *u_fixed;             /* n_fixed: displacement of the fixed DOFs */
+    double fixed_time;           /* u_fixed[0 .. fixed_exact) hold the fixed displacements at this time
+                                    as fs_wedge_prescribe_fixed computes them, and u holds them too */
+    int32_t fixed_exact;         /* (so it computes only the rest; 0: none) */
+    int32_t *fixed_moved;        /* nodes moved since (fs_wedge_node_moved): theirs are computed again */
+    int32_t n_fixed_moved, cap_fixed_moved;
+    bool x_synced;               /* x holds u's free displacements (fs_wedge_relax copies them if not) */
+    int32_t dof_nodes;           /* nodes the last fs_wedge_number_dofs numbered */
+    int32_t dof_kept_nodes;      /* nodes before which it kept every free DOF's index */
     uint8_t *mark;               /* n_free + n_fixed scratch flags, all 0 between calls */
     double assembled_thickness;  /* base thickness (cm) the system was assembled with */
     fs_cholesky *chol;           /* the factor of k_free (CHOLMOD), NULL with CG */
@@ -221,6 +229,16 @@ struct fs_wedge_model {
     double residual_tau;         /* the acceptance bound it was computed with */
     int32_t *dirty_nodes;        /* nodes whose rows a cut changed since the last local relaxation */
     int32_t n_dirty, cap_dirty;
+    struct {                     /* fs_wedge_relax's scratch, at rest between calls (wedge/relax.c) */
+        int32_t node_cap, dof_cap;
+        double *dist;            /* node_cap: INFINITY */
+        uint8_t *flag, *seen;    /* node_cap: 0 */
+        int32_t *map;            /* dof_cap: -1 */
+        uint8_t *saved;          /* dof_cap: 0; 1 where before holds x as it was before the call */
+        double *before;          /* dof_cap */
+        int32_t *touched;        /* the free DOFs saved, n_touched of them (room cap_touched) */
+        int32_t n_touched, cap_touched;
+    } rs;
 
     int64_t fractures;           /* elements removed so far, or node splits (fracture.method = split) */
     fs_wedge_counters counters;
@@ -537,9 +555,19 @@ int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n);
  * seeds first (each once). out has room for w->n_nodes entries; returns the count. */
 int32_t fs_wedge_relax_region(const fs_wedge_model *w, const int32_t *seeds, int32_t n, double radius, int32_t *out);
 
+/* Frees fs_wedge_relax's scratch (w->rs). */
+void fs_wedge_relax_scratch_free(fs_wedge_model *w);
+
 /* Sets the fixed DOFs (bottom nodes, pinned tops) of w->u and w->u_fixed to their prescribed
  * displacement at w->time (growth motion included). */
 void fs_wedge_prescribe_fixed(fs_wedge_model *w);
+
+/* Records that a cut moved node (its position): its fixed displacements are computed again. */
+void fs_wedge_node_moved(fs_wedge_model *w, int32_t node);
+
+/* Copies the free displacements of the nodes from `first` on from w->u into w->x, and marks x in
+ * step with u (x_synced): the caller knows the nodes before first hold them already. */
+void fs_wedge_sync_x(fs_wedge_model *w, int32_t first);
 
 /* Recomputes stress_top and the ratios of the listed elements (all when elems is NULL, n ignored;
  * none listed twice: a long list is split across threads) from w->u, then makes exact every ratio
@@ -591,6 +619,7 @@ void fs_wedge_grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems);
  * and the CHOLMOD factorization (with a new analysis when analyze is set). Return 0 or -1 with
  * fs_error where they return int. */
 void fs_wedge_number_dofs(fs_wedge_model *w);
+void fs_wedge_number_appended(fs_wedge_model *w);
 int32_t fs_wedge_elem_dof(const fs_wedge_model *w, int32_t e, int a);
 void fs_wedge_build_node_elems(fs_wedge_model *w);
 void fs_wedge_update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const int32_t *changed, int32_t n_changed,

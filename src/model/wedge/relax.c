@@ -139,6 +139,65 @@ static int32_t sort_unique(int32_t *v, int32_t n, int32_t range)
     return m;
 }
 
+/* ---- scratch ---- */
+
+/* design: an event relaxes a region of a few hundred nodes, but the model has tens of thousands. So
+ * fs_wedge_relax's per-node and per-DOF scratch stays with the model (w->rs) between calls, every
+ * array back at rest when a call returns (distances INFINITY, flags 0, map -1), and a call touches
+ * only what its region touches: no allocation, fill or copy of the whole mesh per event. The free
+ * displacements before the call, which moved_nodes compares with, are saved the first time an attempt
+ * changes them (save_x) instead of copied whole. */
+
+/* Gives w->rs room for the current nodes and free DOFs, the new room at rest. */
+static void scratch_reserve(fs_wedge_model *w)
+{
+    if (w->rs.node_cap < w->n_nodes) {
+        int32_t old = w->rs.node_cap, cap = w->n_nodes + w->n_nodes / 2 + 16;
+        w->rs.dist = fs_realloc(w->rs.dist, (size_t)cap * sizeof *w->rs.dist);
+        w->rs.flag = fs_realloc(w->rs.flag, (size_t)cap);
+        w->rs.seen = fs_realloc(w->rs.seen, (size_t)cap);
+        for (int32_t i = old; i < cap; i++)
+            w->rs.dist[i] = INFINITY;
+        memset(w->rs.flag + old, 0, (size_t)(cap - old));
+        memset(w->rs.seen + old, 0, (size_t)(cap - old));
+        w->rs.node_cap = cap;
+    }
+    if (w->rs.dof_cap < w->n_free) {
+        int32_t old = w->rs.dof_cap, cap = w->n_free + w->n_free / 2 + 16;
+        w->rs.map = fs_realloc(w->rs.map, (size_t)cap * sizeof *w->rs.map);
+        w->rs.saved = fs_realloc(w->rs.saved, (size_t)cap);
+        w->rs.before = fs_realloc(w->rs.before, (size_t)cap * sizeof *w->rs.before);
+        for (int32_t g = old; g < cap; g++)
+            w->rs.map[g] = -1;
+        memset(w->rs.saved + old, 0, (size_t)(cap - old));
+        w->rs.dof_cap = cap;
+    }
+}
+
+void fs_wedge_relax_scratch_free(fs_wedge_model *w)
+{
+    free(w->rs.dist);
+    free(w->rs.flag);
+    free(w->rs.seen);
+    free(w->rs.map);
+    free(w->rs.saved);
+    free(w->rs.before);
+    free(w->rs.touched);
+    memset(&w->rs, 0, sizeof w->rs);
+}
+
+/* x[g] += d, keeping x[g] as it was before the call the first time. */
+static void save_x(fs_wedge_model *w, int32_t g, double d)
+{
+    if (!w->rs.saved[g]) {
+        w->rs.saved[g] = 1;
+        w->rs.before[g] = w->x[g];
+        FS_ARRAY_RESERVE(w->rs.touched, w->rs.cap_touched, w->rs.n_touched + 1, 256);
+        w->rs.touched[w->rs.n_touched++] = g;
+    }
+    w->x[g] += d;
+}
+
 /* ---- the local solve ---- */
 
 /* design: thesis §5.8.2 solves the marked unknowns with the others held. The bonded layer makes the
@@ -264,7 +323,7 @@ static double radius_cap(const fs_wedge_model *w)
 static int attempt(fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds, double radius, double tol, double *r,
                    double *dist, uint8_t *flag, int32_t *map, int32_t *region, int32_t *n_region_out, int32_t *m_out)
 {
-    int32_t nf = w->n_free, nn = w->n_nodes;
+    int32_t nf = w->n_free;
     int32_t n_region = grow_region(w, seeds, n_seeds, radius, dist, region);
     int32_t *idx = fs_malloc((6 * (size_t)n_region + 1) * sizeof *idx), m = 0;
     for (int32_t a = 0; a < n_region; a++) {
@@ -284,12 +343,10 @@ static int attempt(fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds, dou
         fs_error_clear();
     if (ok) {
         for (int32_t q = 0; q < m; q++) {
-            w->x[idx[q]] += delta[q];
+            save_x(w, idx[q], delta[q]);
             map[idx[q]] = q;
         }
-        uint8_t *seen = fs_calloc((size_t)nn + 1, 1);
-        update_residual(w, region, n_region, flag, idx, m, map, delta, r, seen);
-        free(seen);
+        update_residual(w, region, n_region, flag, idx, m, map, delta, r, w->rs.seen);
         for (int32_t q = 0; q < m; q++)
             map[idx[q]] = -1;
         for (int32_t a = 0; a < n_region; a++)
@@ -321,10 +378,9 @@ static int attempt(fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds, dou
  * then of that order relative to the change, below what the acceptance bound already allows. */
 
 /* Moves the region's nodes (n of them, the first n_seeds of them the seeds, which always count) whose
- * free displacement changed since x_before by more than the fraction of the largest change that the
- * design note gives to the front of region; returns their count. */
-static int32_t moved_nodes(const fs_wedge_model *w, int32_t *region, int32_t n, int32_t n_seeds,
-                           const double *x_before)
+ * free displacement changed since the call began (save_x) by more than the fraction of the largest
+ * change that the design note gives to the front of region; returns their count. */
+static int32_t moved_nodes(const fs_wedge_model *w, int32_t *region, int32_t n, int32_t n_seeds)
 {
     double largest = 0.0;
     double *change = fs_malloc(((size_t)n + 1) * sizeof *change);
@@ -333,7 +389,7 @@ static int32_t moved_nodes(const fs_wedge_model *w, int32_t *region, int32_t n, 
         for (int l = 3; l < 6; l++) {
             int32_t g = w->dof[6 * (size_t)region[a] + l];
             if (g < w->n_free)
-                c = fmax(c, fabs(w->x[g] - x_before[g]));
+                c = fmax(c, fabs(w->x[g] - (w->rs.saved[g] ? w->rs.before[g] : w->x[g])));
         }
         change[a] = c;
         largest = fmax(largest, c);
@@ -354,21 +410,16 @@ static int relax_region(fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds
 {
     int32_t nf = w->n_free, nn = w->n_nodes;
     int32_t *region = fs_malloc(((size_t)nn + 1) * sizeof *region);
-    int32_t *map = fs_malloc(((size_t)nf + 1) * sizeof *map);
-    for (int32_t i = 0; i < nf; i++)
-        map[i] = -1;
-    double *x_before = fs_malloc(((size_t)nf + 1) * sizeof *x_before);
-    memcpy(x_before, w->x, (size_t)nf * sizeof *x_before);
     double radius = w->relax_radius;
     int rc = 0;
     int32_t n_before = -1;
     for (int tries = 0;; tries++) {
         int32_t n_region = 0, m = 0;
-        int ok = attempt(w, seeds, n_seeds, radius, tol, r, dist, flag, map, region, &n_region, &m);
+        int ok = attempt(w, seeds, n_seeds, radius, tol, r, dist, flag, w->rs.map, region, &n_region, &m);
         if (ok && norm_max(r, nf) <= tol) {
             w->counters.local_relaxations++;
             w->relax_radius = tries == 0 ? fmax(RADIUS_SHRINK * radius, w->relax_unit) : radius;
-            rc = local_stresses(w, region, moved_nodes(w, region, n_region, n_seeds, x_before));
+            rc = local_stresses(w, region, moved_nodes(w, region, n_region, n_seeds));
             break;
         }
         double cap = radius_cap(w);
@@ -383,8 +434,9 @@ static int relax_region(fs_wedge_model *w, const int32_t *seeds, int32_t n_seeds
         radius = fmin(RADIUS_GROW * radius, cap);
         n_before = n_region;
     }
-    free(x_before);
-    free(map);
+    for (int32_t q = 0; q < w->rs.n_touched; q++)
+        w->rs.saved[w->rs.touched[q]] = 0;
+    w->rs.n_touched = 0;
     free(region);
 #ifdef FS_VALIDATE
     if (rc == 0)
@@ -448,17 +500,21 @@ int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n)
     }
     int32_t nf = w->n_free, nn = w->n_nodes;
     fs_wedge_prescribe_fixed(w);
+    if (!w->x_synced)
+        fs_wedge_sync_x(w, 0);
+#ifdef FS_VALIDATE
     for (int32_t i = 0; i < nn; i++)
         for (int l = 3; l < 6; l++) {
             int32_t g = w->dof[6 * (size_t)i + l];
-            if (g < nf)
-                w->x[g] = w->u[6 * (size_t)i + l];
+            FS_INVARIANT(g >= nf || memcmp(&w->x[g], &w->u[6 * (size_t)i + l], sizeof *w->x) == 0,
+                         "wedge model at time %g: free DOF %d (node %d) has x %.17g but u %.17g", w->time, (int)g,
+                         (int)i, w->x[g], w->u[6 * (size_t)i + l]);
         }
-    double *dist = fs_malloc(((size_t)nn + 1) * sizeof *dist);
-    uint8_t *flag = fs_calloc((size_t)nn + 1, 1);
+#endif
+    scratch_reserve(w);
+    double *dist = w->rs.dist;
+    uint8_t *flag = w->rs.flag;
     int32_t *seeds = fs_malloc(((size_t)nn + 1) * sizeof *seeds), n_seeds = 0;
-    for (int32_t i = 0; i < nn; i++)
-        dist[i] = INFINITY;
     for (int32_t q = 0; q < n; q++)
         if (!flag[changed_nodes[q]]) {
             flag[changed_nodes[q]] = 1;
@@ -471,15 +527,16 @@ int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n)
         r = fs_realloc(w->residual, ((size_t)nf + 1) * sizeof *r);
         w->residual = NULL;
         tau = w->residual_tau;
-        int32_t cap = 0;
-        for (int32_t i = 0; i < nn; i++)
-            cap = w->node_elem_count[i] > cap ? w->node_elem_count[i] : cap;
-        ilist_t nb = {fs_malloc((3 * (size_t)cap + 1) * sizeof *nb.v), 0};
-        uint8_t *seen = fs_calloc((size_t)nn + 1, 1);
         /* new nodes come last, and so do their unknowns: all of them are recomputed */
-        int32_t first_new = nn;
+        int32_t first_new = nn, cap = 0;
         while (first_new > 0 && w->dof[6 * (size_t)(first_new - 1) + 3] >= w->residual_n)
             first_new--;
+        for (int32_t q = 0; q < w->n_dirty + (nn - first_new); q++) {
+            int32_t i = q < w->n_dirty ? w->dirty_nodes[q] : first_new + (q - w->n_dirty);
+            cap = w->node_elem_count[i] > cap ? w->node_elem_count[i] : cap;
+        }
+        ilist_t nb = {fs_malloc((3 * (size_t)cap + 1) * sizeof *nb.v), 0};
+        uint8_t *seen = w->rs.seen;
         for (int32_t q = 0; q < w->n_dirty + (nn - first_new); q++) {
             int32_t i = q < w->n_dirty ? w->dirty_nodes[q] : first_new + (q - w->n_dirty);
             bool out = false;
@@ -495,7 +552,6 @@ int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n)
                 seeds[n_seeds++] = i;
             }
         }
-        free(seen);
         free(nb.v);
     } else {
         r = fs_malloc(((size_t)nf + 1) * sizeof *r);
@@ -533,8 +589,6 @@ int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n)
         free(r);
     }
     free(seeds);
-    free(flag);
-    free(dist);
     w->counters.local_seconds += fs_seconds() - t0;
     return rc;
 }

@@ -474,11 +474,13 @@ static bool collapse(cut_state *cs, const fs_wedge_frame *f, int32_t v, const do
     bool ok = true;
     for (int32_t q = 0; q < ring.n && ok; q++)
         ok = area_2d(m, f, ring.v[q]) > COLLAPSE_MIN_AREA * before[q];
-    if (!ok)
+    if (!ok) {
         memcpy(m->pos + 3 * (size_t)v, old, sizeof old);
-    else
+    } else {
+        fs_wedge_node_moved(w, v);
         for (int32_t q = 0; q < ring.n; q++)
             fs_cut_mark_changed(&cs->cut, ring.v[q]);
+    }
     free(before);
     free(ring.v);
     return ok;

@@ -568,6 +568,7 @@ int fs_wedge_smooth(fs_wedge_model *w, const int32_t *centres, int32_t n, double
         if (!was_moved[i])
             continue;
         n_moved++;
+        fs_wedge_node_moved(w, i);
         for (int32_t p = w->node_elem_start[i]; p < w->node_elem_start[i] + w->node_elem_count[i]; p++)
             flag[w->node_elem[p]] = 1;
     }

@@ -332,6 +332,8 @@ void fs_wedge_free(fs_wedge_model *w)
     free(w->rhs);
     free(w->x);
     free(w->u_fixed);
+    free(w->fixed_moved);
+    fs_wedge_relax_scratch_free(w);
     free(w->mark);
     fs_cholesky_free(w->chol);
     free(w->tip_node);
