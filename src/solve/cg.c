@@ -174,8 +174,9 @@ static void block3_free(block3_matrix *b)
 }
 
 /* Lays out b's nb block rows from their block counts (next[i], turned into each row's first free
- * slot) and allocates the blocks, zeroed, with no diagonal block found yet. */
-static void block3_alloc(block3_matrix *b, int32_t nb, int32_t *next)
+ * slot) and allocates the blocks (zeroed if zero is set: else the caller writes every entry), with no
+ * diagonal block found yet. */
+static void block3_alloc(block3_matrix *b, int32_t nb, int32_t *next, bool zero)
 {
     b->nb = nb;
     b->row_ptr = fs_malloc(((size_t)nb + 1) * sizeof *b->row_ptr);
@@ -187,7 +188,7 @@ static void block3_alloc(block3_matrix *b, int32_t nb, int32_t *next)
     }
     b->row_ptr[nb] = total;
     b->col = fs_malloc(((size_t)total + 1) * sizeof *b->col);
-    b->v = fs_calloc(9 * ((size_t)total + 1), sizeof *b->v);
+    b->v = zero ? fs_calloc(9 * ((size_t)total + 1), sizeof *b->v) : fs_malloc(9 * ((size_t)total + 1) * sizeof *b->v);
     b->diag = fs_malloc(((size_t)nb + 1) * sizeof *b->diag);
     for (int32_t i = 0; i < nb; i++)
         b->diag[i] = -1;
@@ -213,7 +214,7 @@ static void block3_build(const fs_sparse_matrix *a, block3_matrix *b)
                     next[ib]++;
                 }
             }
-    block3_alloc(b, nb, next);
+    block3_alloc(b, nb, next, true);
     for (int32_t i = 0; i < nb; i++)
         mark[i] = -1;
     /* pass 2: place the blocks (by ascending block column: the diagonal block first) and their values;
@@ -298,7 +299,7 @@ static bool block3_build_regular(const fs_sparse_matrix *a, const int32_t *idx, 
         next[jb]++;
     }
     if (ok)
-        block3_alloc(b, nb, next);
+        block3_alloc(b, nb, next, false); /* pass 2 writes all nine entries of every block */
     /* pass 2: the blocks, a triple of rows of the node's three columns at a time (by ascending block
      * column, so a row's diagonal block comes first); the diagonal block gets both triangles */
     for (int32_t jb = 0; jb < nb && ok; jb++) {
