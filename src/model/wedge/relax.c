@@ -490,7 +490,9 @@ static double row_residual(const fs_wedge_model *w, int32_t g, int32_t node, ili
  * not a pass over the whole matrix. The bound keeps the load norm of the last full computation (a
  * cut changes it by the loads of a few elements). Anything else that moves the model (a global solve,
  * a new time, a removal or subdivision) makes the kept residual invalid, and the next call computes
- * it in full. */
+ * it in full. The same goes for the rest of the state: the fixed DOFs' displacements are computed
+ * only for the nodes a cut added or moved (fs_wedge_prescribe_fixed), x is copied from u only when
+ * something left them apart (x_synced), and the scratch stays allocated (w->rs). */
 int fs_wedge_relax(fs_wedge_model *w, const int32_t *changed_nodes, int32_t n)
 {
     double t0 = fs_seconds();
