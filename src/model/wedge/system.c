@@ -726,11 +726,13 @@ int fs_wedge_readd(fs_wedge_model *w, const int32_t *elems, int32_t n, const uin
 
 /* design: a layer that thickens is refilled at every equilibrium at a new thickness, every element
  * anew. Its element systems (each element writing only its own slots, its stiffness parts included)
- * are computed on several threads, REFILL_CHUNK elements at a time into a buffer,
- * and added into the pattern on the calling thread in element order: the values are those of one
- * loop, whatever the threads. Where each pair of an element's DOFs lies in the pattern is looked up
- * once per pattern (on the threads too) and kept in refill_slot: the event search refills the same
- * pattern at several thicknesses between cuts. */
+ * are computed on several threads a chunk at a time (a quarter of the elements, at least 64 and at
+ * most REFILL_CHUNK) into one of two buffers, and added into the pattern in element order, one chunk
+ * by one thread while the other threads compute the next chunk into the other buffer (the adding
+ * reads nothing the computing writes): the values are those of one loop, whatever the threads. Where
+ * each pair of an element's DOFs lies in the pattern is looked up once per pattern (on the threads
+ * too) and kept in refill_slot: the event search refills the same pattern at several thicknesses
+ * between cuts. */
 #define REFILL_CHUNK 4096
 
 /* refill_slot entries: a slot of k_free (>= 0), of k_fb (-2 - slot), or a fixed-fixed pair left out */
@@ -740,7 +742,7 @@ typedef struct {
     fs_wedge_model *w;
     int32_t e0;
     bool slots;                             /* look the slots up too */
-    double *k;                              /* REFILL_CHUNK stiffness matrices */
+    double *k;                              /* a chunk's stiffness matrices */
     double (*loads)[FS_WEDGE_PATTERNS][18]; /* and their loads */
     uint8_t *failed;                        /* per element of the chunk: its system or cache failed */
     int32_t *slot;                          /* the current element's refill_slot entries */
@@ -786,6 +788,45 @@ static void add_at_slot(void *ctx, int q, int32_t i, int32_t j, double v)
         c->w->k_free.values[c->slot[q]] += v;
     else
         c->w->k_fb.value[-2 - c->slot[q]] += v;
+}
+
+/* One round of the refill: item 0 adds chunk `add` (computed, n_add elements) into the pattern in
+ * element order, items 1 .. FS_RANGE_PARTS compute the parts of chunk `next` (n_next elements). */
+typedef struct {
+    refill_chunk *add, *next;
+    int32_t n_add, n_next;
+    int32_t failed_at; /* the first element of add whose system failed (not added), else -1 */
+} refill_round;
+
+static void add_chunk(refill_round *r)
+{
+    refill_chunk *c = r->add;
+    fs_wedge_model *w = c->w;
+    for (int32_t i = 0; i < r->n_add; i++) {
+        int32_t e = c->e0 + i;
+        if (c->failed[i]) {
+            r->failed_at = i;
+            return;
+        }
+        if (w->state[e] == FS_WEDGE_ALIVE) {
+            c->slot = w->refill_slot + FS_WEDGE_PAIRS * (size_t)e;
+            element_pairs(w, e, c->k + 324 * (size_t)i, add_at_slot, c);
+            add_loads(w, e, c->loads[i], NULL);
+        }
+    }
+}
+
+static void refill_round_item(void *ctx, int32_t item)
+{
+    refill_round *r = ctx;
+    if (item == 0) {
+        if (r->add)
+            add_chunk(r);
+        return;
+    }
+    int32_t i0, i1;
+    fs_parallel_part(r->n_next, FS_RANGE_PARTS, item - 1, &i0, &i1);
+    refill_range(r->next, i0, i1);
 }
 
 /* design: at a new thickness the stress check's element caches (fs_wedge_refresh_cache) are needed
@@ -856,33 +897,45 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
     for (size_t p = 0; p < w->k_fb.used; p++)
         w->k_fb.value[p] = 0.0;
     memset(w->load, 0, (size_t)FS_WEDGE_PATTERNS * w->n_free * sizeof *w->load);
-    int32_t chunk = w->n_elems < REFILL_CHUNK ? w->n_elems : REFILL_CHUNK;
-    refill_chunk c = {w, 0, w->refill_slot_version != w->pattern_version || w->refill_slot_elems < w->n_elems,
-                      fs_malloc((324 * (size_t)chunk + 1) * sizeof *c.k), fs_malloc(((size_t)chunk + 1) * sizeof *c.loads),
-                      fs_malloc((size_t)chunk + 1), NULL};
-    if (c.slots && w->refill_slot_elems < w->n_elems) {
+    /* at least four chunks (of 64 elements or more), so that adding one overlaps computing the next */
+    int32_t chunk = w->n_elems / 4 < 64 ? 64 : (w->n_elems / 4 > REFILL_CHUNK ? REFILL_CHUNK : w->n_elems / 4);
+    bool slots = w->refill_slot_version != w->pattern_version || w->refill_slot_elems < w->n_elems;
+    refill_chunk c[2];
+    for (int b = 0; b < 2; b++)
+        c[b] = (refill_chunk){w, 0, slots, fs_malloc((324 * (size_t)chunk + 1) * sizeof *c[b].k),
+                              fs_malloc(((size_t)chunk + 1) * sizeof *c[b].loads), fs_malloc((size_t)chunk + 1), NULL};
+    if (slots && w->refill_slot_elems < w->n_elems) {
         w->refill_slot_elems = w->n_elems + w->n_elems / 4;
         free(w->refill_slot);
         w->refill_slot = fs_malloc(FS_WEDGE_PAIRS * (size_t)w->refill_slot_elems * sizeof *w->refill_slot);
     }
     int rc = 0;
-    for (; c.e0 < w->n_elems && rc == 0; c.e0 += chunk) {
-        int32_t n = w->n_elems - c.e0 < chunk ? w->n_elems - c.e0 : chunk;
-        fs_parallel_ranges(n, 256, refill_range, &c);
-        for (int32_t i = 0; i < n && rc == 0; i++) {
-            int32_t e = c.e0 + i;
-            if (c.failed[i]) /* again on this thread, for its message (an error is the thread's own) */
-                rc = fs_wedge_element_system(w, e, base_thickness, c.k + 324 * (size_t)i, c.loads[i]);
-            if (rc == 0 && w->state[e] == FS_WEDGE_ALIVE) {
-                c.slot = w->refill_slot + FS_WEDGE_PAIRS * (size_t)e;
-                element_pairs(w, e, c.k + 324 * (size_t)i, add_at_slot, &c);
-                add_loads(w, e, c.loads[i], NULL);
-            }
+    int32_t n_chunks = chunk > 0 ? (w->n_elems + chunk - 1) / chunk : 0;
+    /* round k adds chunk k - 1 and computes chunk k */
+    for (int32_t k = 0; k <= n_chunks && rc == 0; k++) {
+        refill_round r = {k > 0 ? &c[(k - 1) % 2] : NULL, k < n_chunks ? &c[k % 2] : NULL, 0, 0, -1};
+        if (r.add)
+            r.n_add = w->n_elems - r.add->e0 < chunk ? w->n_elems - r.add->e0 : chunk;
+        if (r.next) {
+            r.next->e0 = k * chunk;
+            r.n_next = w->n_elems - r.next->e0 < chunk ? w->n_elems - r.next->e0 : chunk;
+        }
+        if (!r.add)
+            fs_parallel_ranges(r.n_next, 256, refill_range, r.next);
+        else
+            fs_parallel_for(r.next ? 1 + FS_RANGE_PARTS : 1, 0, refill_round_item, &r);
+        if (r.failed_at >= 0) { /* again on this thread, for its message (an error is the thread's own) */
+            int32_t i = r.failed_at;
+            rc = fs_wedge_element_system(w, r.add->e0 + i, base_thickness, r.add->k + 324 * (size_t)i,
+                                         r.add->loads[i]);
+            rc = rc < 0 ? rc : -1;
         }
     }
-    free(c.k);
-    free(c.loads);
-    free(c.failed);
+    for (int b = 0; b < 2; b++) {
+        free(c[b].k);
+        free(c[b].loads);
+        free(c[b].failed);
+    }
     /* a failure leaves slots unset: looked up again next time */
     w->refill_slot_version = rc == 0 ? w->pattern_version : 0;
     if (rc < 0)
