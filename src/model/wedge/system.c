@@ -798,22 +798,30 @@ typedef struct {
     int32_t failed_at; /* the first element of add whose system failed (not added), else -1 */
 } refill_round;
 
-static void add_chunk(refill_round *r)
+/* Adds the elements of chunk r->add from `from` on into the pattern, in element order. An element
+ * whose system failed stops it (failed_at), unless retry is set: then its system is computed again on
+ * this thread (an error is the thread's own, and its message is wanted) and added if that succeeds.
+ * Returns 0, or -1 with fs_error. */
+static int add_chunk(refill_round *r, int32_t from, bool retry)
 {
     refill_chunk *c = r->add;
     fs_wedge_model *w = c->w;
-    for (int32_t i = 0; i < r->n_add; i++) {
+    for (int32_t i = from; i < r->n_add; i++) {
         int32_t e = c->e0 + i;
-        if (c->failed[i]) {
+        if (c->failed[i] && !retry) {
             r->failed_at = i;
-            return;
+            return 0;
         }
+        double *k = c->k + 324 * (size_t)i;
+        if (c->failed[i] && fs_wedge_element_system(w, e, w->assembled_thickness, k, c->loads[i]) < 0)
+            return -1;
         if (w->state[e] == FS_WEDGE_ALIVE) {
             c->slot = w->refill_slot + FS_WEDGE_PAIRS * (size_t)e;
-            element_pairs(w, e, c->k + 324 * (size_t)i, add_at_slot, c);
+            element_pairs(w, e, k, add_at_slot, c);
             add_loads(w, e, c->loads[i], NULL);
         }
     }
+    return 0;
 }
 
 static void refill_round_item(void *ctx, int32_t item)
@@ -821,7 +829,7 @@ static void refill_round_item(void *ctx, int32_t item)
     refill_round *r = ctx;
     if (item == 0) {
         if (r->add)
-            add_chunk(r);
+            add_chunk(r, 0, false);
         return;
     }
     int32_t i0, i1;
@@ -910,7 +918,7 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
         w->refill_slot = fs_malloc(FS_WEDGE_PAIRS * (size_t)w->refill_slot_elems * sizeof *w->refill_slot);
     }
     int rc = 0;
-    int32_t n_chunks = chunk > 0 ? (w->n_elems + chunk - 1) / chunk : 0;
+    int32_t n_chunks = (w->n_elems + chunk - 1) / chunk;
     /* round k adds chunk k - 1 and computes chunk k */
     for (int32_t k = 0; k <= n_chunks && rc == 0; k++) {
         refill_round r = {k > 0 ? &c[(k - 1) % 2] : NULL, k < n_chunks ? &c[k % 2] : NULL, 0, 0, -1};
@@ -924,12 +932,8 @@ int fs_wedge_refill_system(fs_wedge_model *w, double base_thickness)
             fs_parallel_ranges(r.n_next, 256, refill_range, r.next);
         else
             fs_parallel_for(r.next ? 1 + FS_RANGE_PARTS : 1, 0, refill_round_item, &r);
-        if (r.failed_at >= 0) { /* again on this thread, for its message (an error is the thread's own) */
-            int32_t i = r.failed_at;
-            rc = fs_wedge_element_system(w, r.add->e0 + i, base_thickness, r.add->k + 324 * (size_t)i,
-                                         r.add->loads[i]);
-            rc = rc < 0 ? rc : -1;
-        }
+        if (r.failed_at >= 0)
+            rc = add_chunk(&r, r.failed_at, true);
     }
     for (int b = 0; b < 2; b++) {
         free(c[b].k);
