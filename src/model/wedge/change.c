@@ -535,7 +535,7 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
         w->young[e] = w->young[parent];
         w->threshold[e] = w->threshold[parent];
     }
-    fs_wedge_number_appended(w);
+    fs_wedge_number_appended(w, n0);
     fs_wedge_update_node_elems(w, n0, e0, c->changed, c->n_changed, c->node_parent, 2 * (w->n_nodes - n0));
     int32_t n_changed = c->n_changed + (w->n_elems - e0);
     int32_t *changed = fs_malloc(((size_t)n_changed + 1) * sizeof *changed);
@@ -561,8 +561,8 @@ int fs_wedge_apply_change(fs_wedge_model *w, const fs_wedge_change *c)
         rc = fs_wedge_refresh_cache(w, changed, n_changed);
     if (rc == 0) /* the stresses of the changed elements at the displacements carried over */
         rc = fs_wedge_element_ratios(w, changed, n_changed);
-    if (rc == 0) /* the nodes that kept their unknowns and displacements have them in x already */
-        fs_wedge_sync_x(w, synced ? (w->dof_kept_nodes < n0 ? w->dof_kept_nodes : n0) : 0);
+    if (rc == 0) /* the old nodes kept their unknowns and displacements: in x already if it was in step */
+        fs_wedge_sync_x(w, synced ? n0 : 0);
     free(changed);
     free(nodes);
     w->counters.assemble_seconds += fs_seconds() - t0;

@@ -209,8 +209,6 @@ struct fs_wedge_model {
     int32_t *fixed_moved;        /* nodes moved since (fs_wedge_node_moved): theirs are computed again */
     int32_t n_fixed_moved, cap_fixed_moved;
     bool x_synced;               /* x holds u's free displacements (fs_wedge_relax copies them if not) */
-    int32_t dof_nodes;           /* nodes the last fs_wedge_number_dofs numbered */
-    int32_t dof_kept_nodes;      /* nodes before which it kept every free DOF's index */
     uint8_t *mark;               /* n_free + n_fixed scratch flags, all 0 between calls */
     double assembled_thickness;  /* base thickness (cm) the system was assembled with */
     fs_cholesky *chol;           /* the factor of k_free (CHOLMOD), NULL with CG */
@@ -619,7 +617,7 @@ void fs_wedge_grow_arrays(fs_wedge_model *w, int32_t n_nodes, int32_t n_elems);
  * and the CHOLMOD factorization (with a new analysis when analyze is set). Return 0 or -1 with
  * fs_error where they return int. */
 void fs_wedge_number_dofs(fs_wedge_model *w);
-void fs_wedge_number_appended(fs_wedge_model *w);
+void fs_wedge_number_appended(fs_wedge_model *w, int32_t n0);
 int32_t fs_wedge_elem_dof(const fs_wedge_model *w, int32_t e, int a);
 void fs_wedge_build_node_elems(fs_wedge_model *w);
 void fs_wedge_update_node_elems(fs_wedge_model *w, int32_t n0, int32_t e0, const int32_t *changed, int32_t n_changed,

@@ -24,56 +24,48 @@ int32_t fs_wedge_elem_dof(const fs_wedge_model *w, int32_t e, int a)
     return w->dof[6 * (size_t)node + local + a % 3];
 }
 
-/* Numbers the DOFs: free ones (top nodes not pinned) first in node order, then the fixed ones. */
-void fs_wedge_number_dofs(fs_wedge_model *w)
+/* Room in dof and fixed_node_dof for n nodes (with the per-node arrays' room, fs_wedge_grow_arrays). */
+static void dof_reserve(fs_wedge_model *w, int32_t n)
 {
-    int32_t n = w->n_nodes, next = 0, n_free_old = w->n_free, numbered = w->dof ? w->dof_nodes : 0;
-    if (w->dof_cap < n) { /* with the per-node arrays' room (fs_wedge_grow_arrays) */
-        w->dof_cap = w->node_cap > n ? w->node_cap : n;
-        FS_ARRAY_RESIZE(w->dof, 6 * (size_t)w->dof_cap);
-        FS_ARRAY_RESIZE(w->fixed_node_dof, 6 * (size_t)w->dof_cap);
-    }
-    /* what stays: the nodes before the first whose free indices change, the fixed DOFs before the
-     * first whose node DOF changes (the kept displacements, fs_wedge_prescribe_fixed, x_synced) */
-    int32_t kept = numbered;
-    for (int32_t i = 0; i < n; i++)
-        for (int k = 0; k < 3; k++) {
-            int32_t *d = w->dof + 6 * (size_t)i + 3 + k, g = w->pinned[i] ? -1 : next++;
-            if (i < kept && (*d < n_free_old ? *d : -1) != g)
-                kept = i;
-            *d = g;
-        }
-    w->n_free = next;
-    w->dof_kept_nodes = kept;
-    w->dof_nodes = n;
-    w->x_synced = false;
-    for (int32_t i = 0; i < n; i++)
-        for (int l = 0; l < 6; l++) {
-            int32_t *d = w->dof + 6 * (size_t)i + l, j = next - w->n_free;
-            if (l < 3 || *d < 0) {
-                if (j < w->fixed_exact && w->fixed_node_dof[j] != 6 * i + l)
-                    w->fixed_exact = j;
-                w->fixed_node_dof[j] = 6 * i + l;
-                *d = next++;
-            }
-        }
-    w->n_fixed = next - w->n_free;
-    w->fixed_exact = w->fixed_exact < w->n_fixed ? w->fixed_exact : w->n_fixed;
-    w->pattern_version++;
-}
-
-/* fs_wedge_number_dofs after nodes were appended (a cut's copies), the nodes numbered before keeping
- * their pinned flags: those keep their free indices and their places among the fixed DOFs (whose
- * indices move up by the new free DOFs), and the new nodes' DOFs come after, free and fixed. The same
- * numbering, without numbering every node again. */
-void fs_wedge_number_appended(fs_wedge_model *w)
-{
-    int32_t n = w->n_nodes, n0 = w->dof_nodes, nf0 = w->n_free, next = nf0;
     if (w->dof_cap < n) {
         w->dof_cap = w->node_cap > n ? w->node_cap : n;
         FS_ARRAY_RESIZE(w->dof, 6 * (size_t)w->dof_cap);
         FS_ARRAY_RESIZE(w->fixed_node_dof, 6 * (size_t)w->dof_cap);
     }
+}
+
+/* Numbers the DOFs: free ones (top nodes not pinned) first in node order, then the fixed ones. Nothing
+ * kept from the old numbering survives it (the fixed displacements, x in step with u). */
+void fs_wedge_number_dofs(fs_wedge_model *w)
+{
+    int32_t n = w->n_nodes, next = 0;
+    dof_reserve(w, n);
+    for (int32_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++)
+            w->dof[6 * (size_t)i + 3 + k] = w->pinned[i] ? -1 : next++;
+    w->n_free = next;
+    for (int32_t i = 0; i < n; i++)
+        for (int l = 0; l < 6; l++) {
+            int32_t *d = w->dof + 6 * (size_t)i + l;
+            if (l < 3 || *d < 0) {
+                w->fixed_node_dof[next - w->n_free] = 6 * i + l;
+                *d = next++;
+            }
+        }
+    w->n_fixed = next - w->n_free;
+    w->fixed_exact = 0;
+    w->x_synced = false;
+    w->pattern_version++;
+}
+
+/* fs_wedge_number_dofs after nodes n0 .. n_nodes - 1 were appended (a cut's copies), the nodes before
+ * keeping their pinned flags: those keep their free indices and their places among the fixed DOFs
+ * (whose indices move up by the new free DOFs, so the kept fixed displacements stay valid), and the
+ * new nodes' DOFs come after, free and fixed. The same numbering, without numbering every node again. */
+void fs_wedge_number_appended(fs_wedge_model *w, int32_t n0)
+{
+    int32_t n = w->n_nodes, nf0 = w->n_free, next = nf0;
+    dof_reserve(w, n);
     for (int32_t i = n0; i < n; i++)
         for (int k = 0; k < 3; k++)
             w->dof[6 * (size_t)i + 3 + k] = w->pinned[i] ? -1 : next++;
@@ -92,17 +84,15 @@ void fs_wedge_number_appended(fs_wedge_model *w)
             }
         }
     w->n_fixed = j;
-    w->dof_kept_nodes = n0;
-    w->dof_nodes = n;
     w->x_synced = false;
     w->pattern_version++;
 #ifdef FS_VALIDATE
     int32_t *dof = fs_malloc(6 * (size_t)n * sizeof *dof), *fixed = fs_malloc(((size_t)j + 1) * sizeof *fixed);
     memcpy(dof, w->dof, 6 * (size_t)n * sizeof *dof);
     memcpy(fixed, w->fixed_node_dof, (size_t)j * sizeof *fixed);
-    w->dof_nodes = n0;
+    int32_t exact = w->fixed_exact;
     fs_wedge_number_dofs(w);
-    w->dof_kept_nodes = n0;
+    w->fixed_exact = exact;
     FS_INVARIANT(w->n_free == next && w->n_fixed == j && memcmp(dof, w->dof, 6 * (size_t)n * sizeof *dof) == 0 &&
                      memcmp(fixed, w->fixed_node_dof, (size_t)j * sizeof *fixed) == 0,
                  "wedge model: the numbering of %d nodes appended to %d differs from numbering them all", n - n0, n0);
